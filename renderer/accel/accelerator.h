@@ -1,0 +1,98 @@
+// Accelerator: the one interface every ray-query backend implements.
+//
+// How to use:
+//   auto accel = create_accelerator("embree", scene, filter, config);   // builds once
+//   Hit h = accel->intersect(ray, RayKind::Camera);                      // closest hit
+//   Color s = accel->transmittance(shadow_ray);                          // product of Kt along it
+//
+// The interface is virtual only at the per-ray boundary; traversal inside a backend is inlined.
+// A hit is the minimal record {t, u, v, prim, geom, inst}; shading data (normals, UVs, material)
+// is computed afterwards from it by the integrator (Mitsuba's PreliminaryIntersection idea).
+//
+// Surface decisions that need materials (alpha-mask cut-outs, back-face culling of camera rays,
+// the transmittance of a transparent surface) are asked of a SurfaceFilter the caller provides,
+// so backends never look at materials or textures themselves.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "renderer/core/vecmath.h"
+
+namespace whitted {
+
+struct Scene;
+
+/// What a ray is for (statistics, and culling: only camera rays cull back faces).
+enum class RayKind : uint8_t { Camera = 0, Shadow = 1, Reflection = 2, Refraction = 3 };
+
+struct Ray {
+    Vec3f org;
+    Vec3f dir;                                ///< need not be unit length; t is in units of |dir|
+    float tnear = 0.f;
+    float tfar = kInfinity;
+};
+
+constexpr uint32_t kInvalidId = std::numeric_limits<uint32_t>::max();
+
+/// Minimal hit record. geom indexes Scene::meshes (triangles) or, for analytic primitives,
+/// Scene::spheres offset by Scene::meshes.size(); inst indexes Scene::instances (kInvalidId for
+/// primitives that are not instanced). u, v are barycentrics of vertices 1 and 2.
+struct Hit {
+    float t = kInfinity;
+    float u = 0.f, v = 0.f;
+    uint32_t prim = kInvalidId;
+    uint32_t geom = kInvalidId;
+    uint32_t inst = kInvalidId;
+    Vec3f ng;                                 ///< world-space geometric normal (unnormalized)
+    bool valid() const { return geom != kInvalidId; }
+};
+
+/// Material-dependent decisions asked during traversal. Must be thread-safe and pure.
+class SurfaceFilter {
+public:
+    virtual ~SurfaceFilter() = default;
+    /// True when a candidate hit counts for a closest-hit query of this kind (alpha MASK
+    /// cut-outs return false everywhere; camera rays also reject back faces of single-sided
+    /// materials).
+    virtual bool accept(const Ray& ray, const Hit& hit, RayKind kind) const = 0;
+    /// Fraction of light a surface crossing lets through, per channel: 0 for opaque surfaces,
+    /// 1 where an alpha mask cuts the surface away, Kt (or 1 - alpha for BLEND) otherwise.
+    virtual Color transmittance(const Ray& ray, const Hit& hit) const = 0;
+    /// True when no surface of the scene can transmit light (shadow rays may then use any-hit).
+    virtual bool all_opaque() const = 0;
+};
+
+/// Counters a backend keeps (summed over threads by the caller).
+struct AccelStats {
+    double build_seconds = 0.0;
+    size_t bytes = 0;                         ///< memory the structure holds, when known
+};
+
+class Accelerator {
+public:
+    virtual ~Accelerator() = default;
+    /// Closest accepted hit along [tnear, tfar], or an invalid Hit.
+    virtual Hit intersect(const Ray& ray, RayKind kind) const = 0;
+    /// Product of the transmittances of the distinct surfaces crossed in [tnear, tfar]; each
+    /// crossing counts once (de-duplicated per (geom, inst) within a few-ulp t window). Returns
+    /// exactly 0 as soon as an opaque surface is found.
+    virtual Color transmittance(const Ray& ray) const = 0;
+    /// Backend name as given to create_accelerator.
+    virtual std::string name() const = 0;
+    virtual AccelStats stats() const = 0;
+};
+
+/// Settings shared by all backends (each backend may add its own).
+struct AccelConfig {
+    bool robust = false;                      ///< Embree: RTC_SCENE_FLAG_ROBUST
+    int threads = 0;                          ///< 0 = all hardware threads (build)
+};
+
+/// Builds the named backend ("embree"); throws whitted::Error for an unknown name.
+std::unique_ptr<Accelerator> create_accelerator(const std::string& name, const Scene& scene,
+                                                const SurfaceFilter& filter, const AccelConfig& config = {});
+
+}  // namespace whitted

@@ -1,0 +1,51 @@
+// Film: linear RGB beauty plus optional AOVs for a (possibly cropped) region of an image.
+// It only accumulates; output (OCIO + OIIO) lives in renderer/output.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "renderer/core/vecmath.h"
+
+namespace whitted {
+
+/// Which arbitrary output variables to keep (from the pixel-centre camera ray; not filtered).
+struct AovSet {
+    bool depth = false;     ///< camera-space distance along the ray (t * |dir|), inf when missed
+    bool normal = false;    ///< world-space shading normal, 0 when missed
+    bool albedo = false;    ///< kd + kr + kt at the first hit (a denoiser-style albedo)
+    bool prim_id = false;   ///< triangle index within its mesh, -1 (as uint max) when missed
+    bool inst_id = false;   ///< instance index, -1 when missed
+    bool any() const { return depth || normal || albedo || prim_id || inst_id; }
+};
+
+/// Region [x0, x1) x [y0, y1) of the full image (the EXR data window).
+struct PixelWindow {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    int width() const { return x1 - x0; }
+    int height() const { return y1 - y0; }
+    bool operator==(const PixelWindow&) const = default;
+};
+
+struct Film {
+    int full_width = 0, full_height = 0;  ///< the display window
+    PixelWindow window;                   ///< rendered region (crop); pixels below are its size
+    AovSet aovs;
+    std::vector<Color> beauty;            ///< window.width() * window.height(), row-major
+    std::vector<float> depth;
+    std::vector<Vec3f> normal;
+    std::vector<Color> albedo;
+    std::vector<uint32_t> prim_id;
+    std::vector<uint32_t> inst_id;
+
+    Film() = default;
+    /// Allocates the buffers for `window` of a full_width x full_height image.
+    Film(int full_width, int full_height, PixelWindow window, AovSet aovs);
+    int width() const { return window.width(); }
+    int height() const { return window.height(); }
+    /// Index of full-image pixel (x, y), which must lie inside the window.
+    size_t index(int x, int y) const { return size_t(y - window.y0) * size_t(width()) + size_t(x - window.x0); }
+};
+
+}  // namespace whitted

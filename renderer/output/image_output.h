@@ -1,0 +1,60 @@
+// Output: color management through OpenColorIO and image files through OpenImageIO.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "renderer/film/film.h"
+
+namespace whitted {
+
+/// How to turn scene-linear Rec.709 into display values.
+struct ColorSettings {
+    std::string config;                   ///< OCIO config path; empty = $OCIO, else the bundled one
+    std::string display;                  ///< empty = the config's default display
+    std::string view = "Standard";        ///< "Standard" (sRGB curve), "ACES 1.0 SDR-video", "Raw"
+};
+
+/// Path of the OCIO config shipped with whitted (assets/ocio/config.ocio), found next to the
+/// executable's install or source tree.
+std::string bundled_ocio_config();
+
+/// A scene-linear -> display processor (OCIO CPU processor, created once, thread-safe to apply).
+class DisplayTransform {
+public:
+    /// Throws whitted::Error naming the config, display or view when one is unknown.
+    explicit DisplayTransform(const ColorSettings& settings);
+    ~DisplayTransform();
+    DisplayTransform(DisplayTransform&&) noexcept;
+    /// Transforms packed RGB floats in place (not clamped: OCIO does not clamp).
+    void apply(float* rgb, size_t pixel_count) const;
+    Color apply(Color c) const;
+    const std::string& config_path() const;
+    const std::string& display() const;
+    const std::string& view() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> m_impl;
+};
+
+struct OutputSettings {
+    ColorSettings color;
+    int bits = 0;                         ///< 8 or 16 for PNG/TIFF; 0 = 8 (PNG/JPEG), 16 (TIFF)
+    bool exr_half = true;                 ///< EXR beauty as half (true) or float (false)
+    std::map<std::string, std::string> metadata;  ///< written into EXR headers (and PNG text)
+};
+
+/// Writes the film by extension: .exr (scene-linear, AOVs as extra channels, data window =
+/// crop), .png/.jpg/.jpeg/.tif/.tiff (display-referred through OCIO, clamped to [0,1]).
+/// The file is written to a temporary name and renamed, so it is complete or absent.
+/// Throws whitted::Error naming the file on failure (unknown extension, OIIO error).
+void write_image(const Film& film, const std::string& path, const OutputSettings& settings);
+
+/// Reads an image into linear float RGB (EXR as stored; 8/16-bit files decoded by OIIO as
+/// stored, no color conversion). For tests and comparisons.
+std::vector<float> read_image_rgb(const std::string& path, int& width, int& height);
+
+}  // namespace whitted

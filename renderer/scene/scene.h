@@ -1,0 +1,236 @@
+// Scene: the plain data every importer produces and every later stage reads (as const Scene&).
+//
+// Indices, not pointers; no tinygltf, Embree or OIIO types. Geometry is stored per mesh in object
+// space; instances place meshes in the world with a double-precision world_from_object transform.
+// A glTF mesh with several primitives becomes several Meshes (one material each) and a node that
+// uses it becomes one Instance per primitive.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "renderer/core/vecmath.h"
+
+namespace whitted {
+
+// ---------------------------------------------------------------------------------------------
+// Geometry
+
+/// Triangle mesh in object space, one material. Optional attributes are empty when absent.
+struct Mesh {
+    std::string name;                 ///< "<gltf mesh name>/<primitive index>" or a user name
+    std::vector<Vec3f> positions;     ///< object-space vertex positions
+    std::vector<Vec3f> normals;       ///< per-vertex shading normals (unit), same count as positions
+    std::vector<Vec4f> tangents;      ///< xyz unit tangent, w = bitangent sign (+1/-1); may be empty
+    std::vector<Vec2f> uv0;           ///< TEXCOORD_0; may be empty
+    std::vector<Vec2f> uv1;           ///< TEXCOORD_1; may be empty
+    std::vector<Vec4f> colors;        ///< COLOR_0 as linear RGBA; may be empty
+    std::vector<uint32_t> indices;    ///< 3 per triangle, counter-clockwise front faces
+    uint32_t material = 0;            ///< index into Scene::materials
+
+    size_t triangle_count() const { return indices.size() / 3; }
+};
+
+/// A mesh placed in the world.
+struct Instance {
+    uint32_t mesh = 0;                ///< index into Scene::meshes
+    Mat4d world_from_object;          ///< composed in double precision from the node hierarchy
+    std::string node_name;            ///< the glTF node (or scene-file entry) it came from
+    int32_t node = -1;                ///< glTF node index, -1 when not from a glTF node
+};
+
+/// Analytic sphere (scene-file primitive; later issue). Kept here so every stage knows it exists.
+struct Sphere {
+    Vec3d center;                     ///< world-space centre
+    double radius = 1.0;              ///< world-space radius (> 0)
+    uint32_t material = 0;            ///< index into Scene::materials
+    std::string name;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Textures
+
+enum class WrapMode : uint8_t { Repeat, ClampToEdge, MirroredRepeat };
+enum class FilterMode : uint8_t { Nearest, Linear };
+
+/// One MIP level: 8-bit RGBA texels, row-major, top row first (glTF UV (0,0) = top-left).
+struct MipLevel {
+    int width = 0, height = 0;
+    std::vector<uint8_t> texels;      ///< width * height * 4 bytes
+};
+
+/// A decoded texture. Texels stay 8-bit to keep memory in check (a 2k RGBA level is 16 MB);
+/// `srgb` says whether the lookup converts them from the sRGB transfer to linear, so every value
+/// a lookup returns is linear. levels[0] is full resolution; each next level halves (box filter
+/// in linear space).
+struct Texture {
+    std::string name;                 ///< image name or URI, for messages
+    std::vector<MipLevel> levels;
+    bool srgb = false;                ///< true for color data (baseColor, emissive)
+    WrapMode wrap_s = WrapMode::Repeat;
+    WrapMode wrap_t = WrapMode::Repeat;
+    FilterMode mag_filter = FilterMode::Linear;
+    FilterMode min_filter = FilterMode::Linear;
+    bool use_mips = true;             ///< false when the sampler's minFilter has no mipmap
+    int32_t image = -1;               ///< glTF image index it was decoded from (-1 = procedural)
+};
+
+/// KHR_texture_transform: uv' = T * R * S * uv.
+struct TextureTransform {
+    Vec2f offset{0.f, 0.f};
+    float rotation = 0.f;             ///< radians, counter-clockwise in UV space
+    Vec2f scale{1.f, 1.f};
+    bool identity() const { return offset == Vec2f{0, 0} && rotation == 0.f && scale == Vec2f{1, 1}; }
+};
+
+/// A material's reference to a texture.
+struct TextureRef {
+    int32_t texture = -1;             ///< index into Scene::textures, -1 = none
+    uint32_t uv_set = 0;              ///< 0 = TEXCOORD_0, 1 = TEXCOORD_1
+    float scale = 1.f;                ///< normalTexture.scale or occlusionTexture.strength
+    TextureTransform transform;
+    bool valid() const { return texture >= 0; }
+};
+
+// ---------------------------------------------------------------------------------------------
+// Materials
+
+enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
+
+/// The seed's (Whitted 1980) surface coefficients at one point, all linear RGB.
+/// I = Ia*Ka + sum_i Is_i*fat_i*s_i*(kd (N.L) + ks (N.H)^n) + kr*R + kt*T + emission
+struct WhittedCoeffs {
+    Color kd{0.f};                    ///< diffuse reflectance
+    Color ka{0.f};                    ///< ambient reflectance (multiplies the ambient light Ia)
+    Color ks{0.f};                    ///< specular highlight coefficient (Phong-Blinn)
+    float n = 1.f;                    ///< highlight exponent
+    Color kr{0.f};                    ///< mirror reflection weight (the seed's Ks on R)
+    Color kt{0.f};                    ///< transmission weight (the seed's Kt on T)
+    float ior = 1.5f;                 ///< index of refraction of the inside medium
+    bool thin = true;                 ///< thin-walled: transmitted rays go straight through
+    Color emission{0.f};              ///< emitted radiance added as is
+    Color absorption{0.f};            ///< Beer-Lambert coefficient per unit length inside (volume)
+};
+
+/// Which model a material uses: glTF metallic-roughness (mapped per hit point by
+/// shading/material_mapping) or the seed's coefficients given directly (scene files).
+enum class MaterialModel : uint8_t { GltfPbr, Classic };
+
+struct Material {
+    std::string name;
+    MaterialModel model = MaterialModel::GltfPbr;
+
+    // glTF 2.0 core (defaults from the specification)
+    Vec4f base_color{1.f, 1.f, 1.f, 1.f};      ///< linear RGBA factor
+    TextureRef base_color_texture;
+    float metallic = 1.f;
+    float roughness = 1.f;
+    TextureRef metallic_roughness_texture;     ///< B = metallic, G = roughness
+    TextureRef normal_texture;                 ///< scale = normalTexture.scale
+    TextureRef occlusion_texture;              ///< R channel; scale = strength
+    Color emissive{0.f};                       ///< emissiveFactor
+    TextureRef emissive_texture;
+    float emissive_strength = 1.f;             ///< KHR_materials_emissive_strength
+    AlphaMode alpha_mode = AlphaMode::Opaque;
+    float alpha_cutoff = 0.5f;
+    bool double_sided = false;
+    bool unlit = false;                        ///< KHR_materials_unlit
+
+    // KHR_materials_transmission / ior / volume / specular
+    float transmission = 0.f;
+    TextureRef transmission_texture;           ///< R channel
+    float ior = 1.5f;
+    bool has_volume = false;                   ///< KHR_materials_volume present with thickness > 0
+    float thickness = 0.f;
+    Color attenuation_color{1.f};
+    float attenuation_distance = kInfinity;
+    float specular = 1.f;                      ///< KHR_materials_specular specularFactor
+    Color specular_color{1.f};                 ///< specularColorFactor
+    TextureRef specular_texture;               ///< A channel
+    TextureRef specular_color_texture;         ///< RGB, sRGB-encoded
+
+    // MaterialModel::Classic: the seed's parameters, used as given.
+    WhittedCoeffs classic;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Lights and cameras
+
+enum class LightType : uint8_t { Point, Spot, Directional };
+
+/// How light falls off with distance d.
+enum class Attenuation : uint8_t {
+    InverseSquare,   ///< fat = 1/d^2, windowed by `range` when range > 0 (glTF KHR_lights_punctual)
+    Classic,         ///< fat = min(1, 1/(c1 + c2 d + c3 d^2)) (Foley et al.; scene files)
+    None             ///< fat = 1 (directional lights)
+};
+
+/// A punctual light in renderer units: `intensity * color` is the radiant intensity I such that a
+/// surface at distance d facing the light receives I/d^2 (point/spot) or I (directional).
+struct Light {
+    std::string name;
+    LightType type = LightType::Point;
+    Color color{1.f};                 ///< linear RGB
+    float intensity = 1.f;            ///< renderer units (see docs/lights.md)
+    float range = 0.f;                ///< 0 = infinite
+    float inner_cone = 0.f;           ///< spot: radians
+    float outer_cone = kPi / 4.f;     ///< spot: radians
+    Vec3d position;                   ///< world position (point, spot)
+    Vec3d direction{0, 0, -1};        ///< world direction the light travels (spot, directional), unit
+    Attenuation attenuation = Attenuation::InverseSquare;
+    Vec3f classic_c{1.f, 0.f, 0.f};   ///< c1, c2, c3 for Attenuation::Classic
+    bool is_default = false;          ///< added because the scene had no light
+};
+
+enum class CameraType : uint8_t { Perspective, Orthographic };
+
+struct Camera {
+    std::string name;
+    CameraType type = CameraType::Perspective;
+    double yfov = 0.8;                ///< perspective: vertical field of view, radians
+    double aspect = 0.0;              ///< width / height from the file; 0 = not given
+    double xmag = 1.0, ymag = 1.0;    ///< orthographic: half extents
+    double znear = 1e-3;              ///< near clip distance (rays start here)
+    double zfar = 0.0;                ///< 0 = infinite
+    Mat4d world_from_camera;          ///< camera looks down -Z, +Y up (glTF convention)
+    bool is_default = false;          ///< framed from the scene bounds because the file had none
+};
+
+// ---------------------------------------------------------------------------------------------
+// Report of what an importer did
+
+/// How an extension was handled.
+enum class ExtensionSupport : uint8_t { Supported, Ignored, Refused };
+
+struct ExtensionUse {
+    std::string name;
+    ExtensionSupport support = ExtensionSupport::Supported;
+    bool required = false;            ///< listed in extensionsRequired
+    std::string note;                 ///< e.g. "first frame / bind pose"
+};
+
+// ---------------------------------------------------------------------------------------------
+
+struct Scene {
+    std::string source;               ///< file the scene came from
+    std::vector<Mesh> meshes;
+    std::vector<Instance> instances;
+    std::vector<Sphere> spheres;
+    std::vector<Material> materials;  ///< never empty after import (a default material is added)
+    std::vector<Texture> textures;
+    std::vector<Light> lights;
+    std::vector<Camera> cameras;
+    std::vector<ExtensionUse> extensions;
+    std::vector<std::string> warnings;  ///< each distinct warning once
+
+    /// Adds a warning unless the same text was already recorded.
+    void warn(const std::string& message);
+    /// World-space bounds of all instances and spheres (computed, not cached).
+    Bounds3d world_bounds() const;
+    /// Total triangles over instances (a mesh used twice counts twice).
+    size_t instanced_triangle_count() const;
+    size_t mesh_triangle_count() const;
+};
+
+}  // namespace whitted
