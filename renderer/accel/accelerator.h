@@ -46,7 +46,6 @@ struct Hit {
     uint32_t prim = kInvalidId;
     uint32_t geom = kInvalidId;
     uint32_t inst = kInvalidId;
-    Vec3f ng;                                 ///< world-space geometric normal (unnormalized)
     bool valid() const { return geom != kInvalidId; }
 };
 
@@ -61,8 +60,12 @@ public:
     /// Fraction of light a surface crossing lets through, per channel: 0 for opaque surfaces,
     /// 1 where an alpha mask cuts the surface away, Kt (or 1 - alpha for BLEND) otherwise.
     virtual Color transmittance(const Ray& ray, const Hit& hit) const = 0;
-    /// True when no surface of the scene can transmit light (shadow rays may then use any-hit).
-    virtual bool all_opaque() const = 0;
+    /// What mesh `geom` needs from traversal: a combination of the SurfaceFilter::k* flags.
+    /// Backends skip the filter calls a mesh does not need (a plain opaque mesh needs none).
+    virtual uint32_t mesh_flags(uint32_t geom) const = 0;
+
+    static constexpr uint32_t kNeedsAccept = 1u;         ///< call accept() on closest-hit candidates
+    static constexpr uint32_t kNeedsTransmittance = 2u;  ///< call transmittance() on shadow candidates
 };
 
 /// Counters a backend keeps (summed over threads by the caller).

@@ -1,1 +1,437 @@
-// placeholder: implemented in progress
+// Output: scene-linear film -> OpenColorIO display transform -> OpenImageIO file.
+//
+// The pipeline for display-referred files (PNG/JPEG/TIFF) is
+//     scene-linear Rec.709 -> OCIO DisplayViewTransform -> sanitize + clamp [0,1] -> quantize
+// while EXR stores the scene-linear values untouched (plus AOVs). Every file is written to a
+// temporary name in the destination directory and renamed, so a reader sees a complete file
+// or none. See docs/color.md.
+
+#include "renderer/output/image_output.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <string_view>
+#include <system_error>
+
+#include <unistd.h>
+
+#include <OpenColorIO/OpenColorIO.h>
+#include <OpenImageIO/half.h>
+#include <OpenImageIO/imageio.h>
+
+#include "renderer/core/error.h"
+#include "renderer/core/log.h"
+
+namespace OCIO = OCIO_NAMESPACE;
+namespace fs = std::filesystem;
+
+namespace whitted {
+
+namespace {
+
+// Comma-separated list of names for error messages ("a, b, c").
+std::string join_names(const std::vector<std::string>& names) {
+    std::string s;
+    for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
+    return s;
+}
+
+bool file_exists(const fs::path& p) {
+    std::error_code ec;
+    return fs::is_regular_file(p, ec);
+}
+
+}  // namespace
+
+// ---- bundled config --------------------------------------------------------------------------
+
+std::string bundled_ocio_config() {
+    constexpr const char* kRelative = "ocio/config.ocio";
+    std::vector<fs::path> candidates;
+
+    // Relative to the running executable: installed tree first, then build trees inside or next
+    // to the source tree (build/apps/whitted, build/tests/test_x, build/whitted).
+    std::error_code ec;
+    fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (!ec && !exe.empty()) {
+        fs::path dir = exe.parent_path();
+        candidates.push_back(dir / "../share/whitted" / kRelative);
+        candidates.push_back(dir / "../assets" / kRelative);
+        candidates.push_back(dir / "../../assets" / kRelative);
+        candidates.push_back(dir / "../../../assets" / kRelative);
+    }
+    // The source tree this binary was configured from.
+#ifdef WHITTED_SOURCE_DIR
+    candidates.push_back(fs::path(WHITTED_SOURCE_DIR) / "assets" / kRelative);
+#endif
+
+    for (const fs::path& c : candidates)
+        if (file_exists(c)) return c.lexically_normal().string();
+
+    std::vector<std::string> tried;
+    for (const fs::path& c : candidates) tried.push_back(c.lexically_normal().string());
+    throw Error(fmt::format("bundled OCIO config not found (looked in: {})", join_names(tried)));
+}
+
+// ---- DisplayTransform ------------------------------------------------------------------------
+
+struct DisplayTransform::Impl {
+    std::string config_path;
+    std::string display;
+    std::string view;
+    OCIO::ConstConfigRcPtr config;
+    OCIO::ConstCPUProcessorRcPtr cpu;  ///< F32 RGB in, F32 RGB out; apply() is const and thread-safe
+};
+
+DisplayTransform::DisplayTransform(const ColorSettings& settings) : m_impl(std::make_unique<Impl>()) {
+    Impl& impl = *m_impl;
+
+    // Resolve the config: explicit setting, then $OCIO (the ecosystem convention), then ours.
+    std::string source;
+    if (!settings.config.empty()) {
+        impl.config_path = settings.config;
+        source = "--ocio-config";
+    } else if (const char* env = std::getenv("OCIO"); env != nullptr && env[0] != '\0') {
+        impl.config_path = env;
+        source = "$OCIO";
+    } else {
+        impl.config_path = bundled_ocio_config();
+        source = "bundled";
+    }
+    if (!file_exists(impl.config_path))
+        throw Error(fmt::format("OCIO config '{}' (from {}) not found", impl.config_path, source));
+
+    try {
+        impl.config = OCIO::Config::CreateFromFile(impl.config_path.c_str());
+        impl.config->validate();
+    } catch (const OCIO::Exception& e) {
+        throw Error(fmt::format("OCIO config '{}' (from {}): {}", impl.config_path, source, e.what()));
+    }
+    const OCIO::Config& config = *impl.config;
+
+    // Display: the requested one, or the config's default.
+    std::vector<std::string> displays;
+    for (int i = 0; i < config.getNumDisplays(); ++i) displays.emplace_back(config.getDisplay(i));
+    impl.display = settings.display.empty() ? std::string(config.getDefaultDisplay()) : settings.display;
+    if (std::find(displays.begin(), displays.end(), impl.display) == displays.end())
+        throw Error(fmt::format("unknown OCIO display '{}' in config '{}' (valid displays: {})", impl.display,
+                                impl.config_path, join_names(displays)));
+
+    // View: the requested one, or the display's default when empty.
+    std::vector<std::string> views;
+    for (int i = 0; i < config.getNumViews(impl.display.c_str()); ++i)
+        views.emplace_back(config.getView(impl.display.c_str(), i));
+    impl.view = settings.view.empty() ? std::string(config.getDefaultView(impl.display.c_str())) : settings.view;
+    if (std::find(views.begin(), views.end(), impl.view) == views.end())
+        throw Error(fmt::format("unknown OCIO view '{}' for display '{}' in config '{}' (valid views: {})", impl.view,
+                                impl.display, impl.config_path, join_names(views)));
+
+    // scene_linear -> (display, view), compiled once into a float CPU processor.
+    try {
+        OCIO::DisplayViewTransformRcPtr transform = OCIO::DisplayViewTransform::Create();
+        transform->setSrc(OCIO::ROLE_SCENE_LINEAR);
+        transform->setDisplay(impl.display.c_str());
+        transform->setView(impl.view.c_str());
+        impl.cpu = config.getProcessor(transform)->getDefaultCPUProcessor();
+    } catch (const OCIO::Exception& e) {
+        throw Error(fmt::format("OCIO config '{}': cannot build display '{}' view '{}': {}", impl.config_path,
+                                impl.display, impl.view, e.what()));
+    }
+    log_debug("OCIO: config '{}' ({}), display '{}', view '{}'", impl.config_path, source, impl.display, impl.view);
+}
+
+DisplayTransform::~DisplayTransform() = default;
+DisplayTransform::DisplayTransform(DisplayTransform&&) noexcept = default;
+
+void DisplayTransform::apply(float* rgb, size_t pixel_count) const {
+    // OCIO converts packed RGB through an RGBA scratch line as long as the image row: process
+    // bounded rows so the scratch stays small for any image size.
+    constexpr size_t kChunk = 4096;
+    for (size_t first = 0; first < pixel_count; first += kChunk) {
+        size_t n = std::min(kChunk, pixel_count - first);
+        OCIO::PackedImageDesc desc(rgb + 3 * first, long(n), 1, 3);
+        m_impl->cpu->apply(desc);
+    }
+}
+
+Color DisplayTransform::apply(Color c) const {
+    std::array<float, 3> p{c.x, c.y, c.z};
+    m_impl->cpu->applyRGB(p.data());
+    return {p[0], p[1], p[2]};
+}
+
+const std::string& DisplayTransform::config_path() const { return m_impl->config_path; }
+const std::string& DisplayTransform::display() const { return m_impl->display; }
+const std::string& DisplayTransform::view() const { return m_impl->view; }
+
+// ---- image files -----------------------------------------------------------------------------
+
+namespace {
+
+enum class FileKind { Exr, Png, Jpeg, Tiff };
+
+constexpr std::string_view kSupportedExtensions = ".exr, .png, .jpg, .jpeg, .tif, .tiff";
+
+/// The file kind for an extension (case-insensitive, with the dot), or nothing.
+std::optional<FileKind> kind_from_extension(std::string ext) {
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+    if (ext == ".exr") return FileKind::Exr;
+    if (ext == ".png") return FileKind::Png;
+    if (ext == ".jpg" || ext == ".jpeg") return FileKind::Jpeg;
+    if (ext == ".tif" || ext == ".tiff") return FileKind::Tiff;
+    return std::nullopt;
+}
+
+/// OIIO format name, so the writer never depends on how OIIO parses the temporary name.
+const char* oiio_format_name(FileKind kind) {
+    switch (kind) {
+        case FileKind::Exr: return "openexr";
+        case FileKind::Png: return "png";
+        case FileKind::Jpeg: return "jpeg";
+        case FileKind::Tiff: return "tiff";
+    }
+    return "";
+}
+
+/// Checks that the film's buffers match its window; a mismatch is a caller bug worth a clear error.
+void validate_film(const Film& film, const std::string& path) {
+    const PixelWindow& w = film.window;
+    if (w.width() <= 0 || w.height() <= 0)
+        throw Error(fmt::format("{}: empty film window [{}, {}) x [{}, {})", path, w.x0, w.x1, w.y0, w.y1));
+    if (w.x0 < 0 || w.y0 < 0 || w.x1 > film.full_width || w.y1 > film.full_height)
+        throw Error(fmt::format("{}: film window [{}, {}) x [{}, {}) outside the {}x{} image", path, w.x0, w.x1, w.y0,
+                                w.y1, film.full_width, film.full_height));
+    const size_t n = size_t(w.width()) * size_t(w.height());
+    auto check = [&](bool wanted, size_t size, const char* name) {
+        if (wanted && size != n)
+            throw Error(fmt::format("{}: film {} buffer has {} pixels, window has {}", path, name, size, n));
+    };
+    check(true, film.beauty.size(), "beauty");
+    check(film.aovs.depth, film.depth.size(), "depth");
+    check(film.aovs.normal, film.normal.size(), "normal");
+    check(film.aovs.albedo, film.albedo.size(), "albedo");
+    check(film.aovs.prim_id, film.prim_id.size(), "prim_id");
+    check(film.aovs.inst_id, film.inst_id.size(), "inst_id");
+}
+
+/// One image ready for OIIO: its spec and pixels in `format` (TypeUnknown = native per-channel).
+struct EncodedImage {
+    OIIO::ImageSpec spec;
+    OIIO::TypeDesc format = OIIO::TypeUnknown;
+    std::vector<unsigned char> bytes;
+};
+
+/// Appends the raw bytes of `value` to `out` (native layout for per-channel EXR formats).
+template <typename T>
+void append_bytes(std::vector<unsigned char>& out, const T& value) {
+    const auto* p = reinterpret_cast<const unsigned char*>(&value);
+    out.insert(out.end(), p, p + sizeof(T));
+}
+
+/// Scene-linear EXR: beauty (half or float) + AOVs, data window = film window inside the
+/// full_width x full_height display window.
+EncodedImage encode_exr(const Film& film, const OutputSettings& settings) {
+    const OIIO::TypeDesc beauty_type = settings.exr_half ? OIIO::TypeHalf : OIIO::TypeFloat;
+    EncodedImage image;
+    OIIO::ImageSpec& spec = image.spec;
+    spec = OIIO::ImageSpec(film.width(), film.height(), 3, beauty_type);
+
+    // Channel layout; AOVs are data, so they stay float (ids: 32-bit unsigned) in either mode.
+    std::vector<std::string> names{"R", "G", "B"};
+    std::vector<OIIO::TypeDesc> formats(3, beauty_type);
+    auto add = [&](std::initializer_list<const char*> channel_names, OIIO::TypeDesc type) {
+        for (const char* name : channel_names) {
+            names.emplace_back(name);
+            formats.push_back(type);
+        }
+    };
+    if (film.aovs.depth) add({"Z"}, OIIO::TypeFloat);
+    if (film.aovs.normal) add({"N.X", "N.Y", "N.Z"}, OIIO::TypeFloat);
+    if (film.aovs.albedo) add({"albedo.R", "albedo.G", "albedo.B"}, OIIO::TypeFloat);
+    if (film.aovs.prim_id) add({"primId"}, OIIO::TypeUInt);
+    if (film.aovs.inst_id) add({"instId"}, OIIO::TypeUInt);
+
+    spec.nchannels = int(names.size());
+    spec.channelnames = names;
+    spec.alpha_channel = -1;
+    spec.z_channel = film.aovs.depth ? 3 : -1;
+    // A uniform format needs no per-channel list; otherwise `format` is the most precise one.
+    const bool mixed = std::any_of(formats.begin(), formats.end(), [&](OIIO::TypeDesc t) { return t != beauty_type; });
+    if (mixed) {
+        spec.channelformats = formats;
+        spec.format = OIIO::TypeFloat;
+    }
+
+    // Crop: data window inside the display window.
+    spec.x = film.window.x0;
+    spec.y = film.window.y0;
+    spec.full_x = 0;
+    spec.full_y = 0;
+    spec.full_width = film.full_width;
+    spec.full_height = film.full_height;
+    spec.attribute("compression", "zip");
+
+    // Pack the pixels in the file's native per-channel layout, so ids stay exact 32-bit values.
+    const size_t n = film.beauty.size();
+    image.bytes.reserve(n * spec.pixel_bytes(true));
+    for (size_t i = 0; i < n; ++i) {
+        const Color& c = film.beauty[i];
+        for (float v : {c.x, c.y, c.z}) {
+            if (settings.exr_half)
+                append_bytes(image.bytes, Imath::half(v));
+            else
+                append_bytes(image.bytes, v);
+        }
+        if (film.aovs.depth) append_bytes(image.bytes, film.depth[i]);
+        if (film.aovs.normal) {
+            const Vec3f& v = film.normal[i];
+            for (float f : {v.x, v.y, v.z}) append_bytes(image.bytes, f);
+        }
+        if (film.aovs.albedo) {
+            const Color& a = film.albedo[i];
+            for (float f : {a.x, a.y, a.z}) append_bytes(image.bytes, f);
+        }
+        if (film.aovs.prim_id) append_bytes(image.bytes, film.prim_id[i]);
+        if (film.aovs.inst_id) append_bytes(image.bytes, film.inst_id[i]);
+    }
+    RT_CHECK_EQ(image.bytes.size(), n * spec.pixel_bytes(true));
+    image.format = OIIO::TypeUnknown;
+    return image;
+}
+
+/// Display-referred 8/16-bit image of the film window (the crop origin is not stored: PNG and
+/// JPEG have no data window, so these files hold exactly the rendered pixels).
+EncodedImage encode_display(const Film& film, FileKind kind, const OutputSettings& settings,
+                            const std::string& path) {
+    const int bits = settings.bits != 0 ? settings.bits : (kind == FileKind::Tiff ? 16 : 8);
+    if (bits != 8 && bits != 16)
+        throw Error(fmt::format("{}: unsupported bit depth {} (use 8 or 16)", path, settings.bits));
+    if (bits == 16 && kind == FileKind::Jpeg) throw Error(fmt::format("{}: JPEG supports only 8 bits", path));
+
+    // Sanitize before the transform: NaN -> 0 and +-inf -> +-65504 (half max), so that
+    // transforms mixing channels (the ACES matrices) never turn one bad channel into NaN.
+    constexpr float kLarge = 65504.f;
+    std::vector<float> rgb(film.beauty.size() * 3);
+    for (size_t i = 0; i < film.beauty.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            float v = film.beauty[i][c];
+            rgb[3 * i + size_t(c)] = std::isnan(v) ? 0.f : std::clamp(v, -kLarge, kLarge);
+        }
+
+    std::optional<DisplayTransform> transform;
+    try {
+        transform.emplace(settings.color);
+    } catch (const Error& e) {
+        throw Error(fmt::format("{}: {}", path, e.what()));
+    }
+    transform->apply(rgb.data(), film.beauty.size());
+
+    EncodedImage image;
+    image.format = bits == 16 ? OIIO::TypeUInt16 : OIIO::TypeUInt8;
+    image.spec = OIIO::ImageSpec(film.width(), film.height(), 3, image.format);
+    const float scale = bits == 16 ? 65535.f : 255.f;
+    const size_t bytes_per_value = bits == 16 ? 2 : 1;
+    image.bytes.resize(rgb.size() * bytes_per_value);
+    for (size_t i = 0; i < rgb.size(); ++i) {
+        // After the transform (OCIO does not clamp): NaN -> 0, then clamp to [0, 1] (+inf -> 1),
+        // then round to nearest. Deterministic: no dithering.
+        float v = rgb[i];
+        v = std::isnan(v) ? 0.f : std::clamp(v, 0.f, 1.f);
+        const auto code = static_cast<uint32_t>(v * scale + 0.5f);
+        if (bits == 16) {
+            const auto q = static_cast<uint16_t>(code);
+            std::memcpy(&image.bytes[2 * i], &q, 2);
+        } else {
+            image.bytes[i] = static_cast<unsigned char>(code);
+        }
+    }
+
+    if (kind == FileKind::Tiff) image.spec.attribute("compression", "zip");
+    image.spec.attribute("whitted:display", transform->display());
+    image.spec.attribute("whitted:view", transform->view());
+    return image;
+}
+
+/// Writes `image` to "<dir>/.<stem>.tmp-<pid><ext>" and renames it to `path`; on failure the
+/// temporary file is removed and whitted::Error("<path>: <reason>") is thrown.
+void write_atomically(const EncodedImage& image, FileKind kind, const fs::path& path) {
+    const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec))
+        throw Error(fmt::format("{}: directory '{}' does not exist", path.string(), dir.string()));
+
+    // The real extension stays last so that every tool recognises the temporary file's format.
+    const fs::path temp =
+        dir / fmt::format(".{}.tmp-{}{}", path.stem().string(), long(::getpid()), path.extension().string());
+    auto fail = [&](const std::string& reason) {
+        std::error_code ignored;
+        fs::remove(temp, ignored);
+        return Error(fmt::format("{}: {}", path.string(), reason));
+    };
+
+    auto out = OIIO::ImageOutput::create(oiio_format_name(kind));
+    if (!out) throw fail(OIIO::geterror());
+    if (!out->open(temp.string(), image.spec)) throw fail(out->geterror());
+    if (!out->write_image(image.format, image.bytes.data())) {
+        std::string reason = out->geterror();
+        out->close();
+        throw fail(reason);
+    }
+    if (!out->close()) throw fail(out->geterror());
+    out.reset();
+
+    fs::rename(temp, path, ec);
+    if (ec) throw fail(fmt::format("cannot rename '{}': {}", temp.string(), ec.message()));
+}
+
+}  // namespace
+
+void write_image(const Film& film, const std::string& path, const OutputSettings& settings) {
+    const fs::path file(path);
+    const std::optional<FileKind> kind = kind_from_extension(file.extension().string());
+    if (!kind)
+        throw Error(fmt::format("{}: unsupported image extension '{}' (supported: {})", path,
+                                file.extension().string(), kSupportedExtensions));
+    validate_film(film, path);
+
+    EncodedImage image =
+        *kind == FileKind::Exr ? encode_exr(film, settings) : encode_display(film, *kind, settings, path);
+    // Metadata as string attributes: EXR header attributes, PNG text chunks, TIFF/JPEG where
+    // the format has a place for them (OIIO drops the rest). The caller's keys win.
+    image.spec.attribute("Software", "whitted " WHITTED_VERSION);
+    for (const auto& [key, value] : settings.metadata) image.spec.attribute(key, value);
+
+    write_atomically(image, *kind, file);
+    log_debug("wrote {} ({}x{}, {} channels)", path, image.spec.width, image.spec.height, image.spec.nchannels);
+}
+
+std::vector<float> read_image_rgb(const std::string& path, int& width, int& height) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw Error(fmt::format("{}: {}", path, OIIO::geterror()));
+    const OIIO::ImageSpec& spec = in->spec();
+    width = spec.width;
+    height = spec.height;
+    const size_t n = size_t(width) * size_t(height);
+
+    // The first three channels; a one- or two-channel (grey, grey + alpha) image repeats grey.
+    const int channels = std::min(spec.nchannels, 3);
+    std::vector<float> read(n * size_t(channels));
+    if (!in->read_image(0, 0, 0, channels, OIIO::TypeFloat, read.data())) {
+        std::string reason = in->geterror();
+        throw Error(fmt::format("{}: {}", path, reason));
+    }
+    if (channels == 3) return read;
+    std::vector<float> rgb(n * 3);
+    for (size_t i = 0; i < n; ++i)
+        for (size_t c = 0; c < 3; ++c) rgb[3 * i + c] = read[i * size_t(channels)];
+    return rgb;
+}
+
+}  // namespace whitted

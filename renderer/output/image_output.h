@@ -14,7 +14,7 @@ namespace whitted {
 struct ColorSettings {
     std::string config;                   ///< OCIO config path; empty = $OCIO, else the bundled one
     std::string display;                  ///< empty = the config's default display
-    std::string view = "Standard";        ///< "Standard" (sRGB curve), "ACES 1.0 SDR-video", "Raw"
+    std::string view = "Standard";        ///< "Standard" (sRGB curve), "ACES 1.0 SDR-video", "Raw"; empty = the display's default
 };
 
 /// Path of the OCIO config shipped with whitted (assets/ocio/config.ocio), found next to the

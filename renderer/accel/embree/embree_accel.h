@@ -1,0 +1,22 @@
+// Embree 3 backend: the production path.
+#pragma once
+
+#include <memory>
+
+#include "renderer/accel/accelerator.h"
+
+namespace whitted {
+
+/// Settings of the Embree backend. Build quality is pinned to MEDIUM: HIGH uses spatial splits,
+/// whose build is not deterministic, and the image must not depend on the thread count.
+struct EmbreeConfig {
+    bool robust = false;   ///< RTC_SCENE_FLAG_ROBUST: slower traversal that avoids some edge misses
+    int threads = 0;       ///< build threads, 0 = all
+};
+
+/// Builds Embree scenes for `scene` (one triangle scene per mesh, one instance per Instance).
+/// Throws whitted::Error when Embree reports an error (the device callback routes to it).
+std::unique_ptr<Accelerator> create_embree_accelerator(const Scene& scene, const SurfaceFilter& filter,
+                                                       const EmbreeConfig& config);
+
+}  // namespace whitted

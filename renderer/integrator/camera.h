@@ -1,0 +1,34 @@
+// Camera rays from a Scene camera (perspective or orthographic, glTF conventions).
+#pragma once
+
+#include "renderer/accel/accelerator.h"
+#include "renderer/scene/scene.h"
+
+namespace whitted {
+
+struct ImageSize {
+    int width = 0, height = 0;
+};
+
+/// Output resolution: the camera's aspect ratio (or 4:3 when the file gives none) completes a
+/// missing dimension; when both are given they win and the field of view widens or narrows
+/// horizontally (pixels stay square, nothing is stretched). 0 = not given. Default width 640.
+ImageSize resolve_image_size(const Camera& camera, int width, int height);
+
+/// Generates world-space camera rays for an image of the given size.
+class CameraModel {
+public:
+    CameraModel(const Camera& camera, int width, int height);
+    /// Ray through image position (x, y) in pixels, (0, 0) = top-left corner of the image,
+    /// (width, height) = bottom-right; pixel centres are at +0.5. Direction is unit length.
+    Ray generate(double x, double y) const;
+
+private:
+    CameraType m_type;
+    Vec3d m_origin, m_right, m_up, m_forward;  ///< world-space camera frame (unit axes)
+    double m_half_w = 1, m_half_h = 1;         ///< image-plane half extents at distance 1 (or ortho mags)
+    double m_znear = 0, m_zfar = 0;
+    int m_width, m_height;
+};
+
+}  // namespace whitted

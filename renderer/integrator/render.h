@@ -1,0 +1,69 @@
+// Renderer: builds the accelerator for a scene once and renders it tile by tile over TBB.
+// The image is bit-identical whatever the thread count or tile size: every pixel is computed
+// independently from its own camera ray, there are no float reductions across threads.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "renderer/accel/accelerator.h"
+#include "renderer/film/film.h"
+#include "renderer/integrator/camera.h"
+#include "renderer/integrator/scene_view.h"
+#include "renderer/integrator/whitted_integrator.h"
+
+namespace whitted {
+
+struct RenderSettings {
+    int width = 0, height = 0;            ///< pixels; 0 = from the camera's aspect ratio (default 640 wide)
+    int camera = 0;                       ///< index into Scene::cameras
+    IntegratorSettings integrator;        ///< depth, background, ambient, fresnel
+    MappingOptions mapping;               ///< glTF -> Whitted mapping options
+    float exposure = 1.f;                 ///< linear scale applied to the radiance (2^stops from the CLI)
+    int tile_size = 32;                   ///< square tiles of this many pixels
+    int threads = 0;                      ///< 0 = all hardware threads
+    std::optional<PixelWindow> crop;      ///< render only this region of the full image
+    AovSet aovs;                          ///< extra outputs from the pixel-centre camera ray
+    std::string accel = "embree";         ///< accelerator backend
+    bool robust = false;                  ///< Embree ROBUST mode
+    bool progress = false;                ///< progress bar with ETA on stderr (when it is a terminal)
+};
+
+struct RenderStats {
+    double build_seconds = 0.0;           ///< accelerator build
+    double render_seconds = 0.0;          ///< tracing all tiles
+    RayCounters rays;
+    uint64_t nonfinite_samples = 0;       ///< samples that were NaN/inf and were replaced by 0
+    int threads = 0;                      ///< worker threads used
+};
+
+class Renderer {
+public:
+    /// Validates the settings against the scene (camera index, crop, sizes) and builds the
+    /// accelerator; throws whitted::Error on bad settings.
+    Renderer(const Scene& scene, const RenderSettings& settings);
+    ~Renderer();
+
+    /// Renders the (cropped) image. Safe to call repeatedly.
+    Film render(RenderStats* stats = nullptr) const;
+
+    ImageSize image_size() const { return m_size; }
+    const Accelerator& accelerator() const { return *m_accel; }
+    const SceneView& view() const { return m_view; }
+    double build_seconds() const { return m_build_seconds; }
+
+private:
+    const Scene& m_scene;
+    RenderSettings m_settings;
+    ImageSize m_size;
+    PixelWindow m_window;
+    SceneView m_view;
+    std::unique_ptr<Accelerator> m_accel;
+    double m_build_seconds = 0.0;
+};
+
+/// Parses "x0,y0,x1,y1" (pixels, x1/y1 exclusive); throws whitted::Error when malformed.
+PixelWindow parse_crop(const std::string& text);
+
+}  // namespace whitted

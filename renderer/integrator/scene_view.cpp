@@ -1,0 +1,198 @@
+#include "renderer/integrator/scene_view.h"
+
+#include <cmath>
+
+#include "shading/texture_sampling.h"
+
+namespace whitted {
+
+namespace {
+
+Vec3f xf_point(const float* m, const Vec3f& p) {
+    return {m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+            m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]};
+}
+Vec3f xf_vector(const float* m, const Vec3f& v) {
+    return {m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
+            m[8] * v.x + m[9] * v.y + m[10] * v.z};
+}
+Vec3f xf_normal(const float* n, const Vec3f& v) {
+    return {n[0] * v.x + n[1] * v.y + n[2] * v.z, n[3] * v.x + n[4] * v.y + n[5] * v.z,
+            n[6] * v.x + n[7] * v.y + n[8] * v.z};
+}
+
+template <typename T>
+T interpolate(const std::vector<T>& a, uint32_t i0, uint32_t i1, uint32_t i2, float u, float v) {
+    const float w = 1.f - u - v;
+    const T& x = a[i0];
+    const T& y = a[i1];
+    const T& z = a[i2];
+    if constexpr (std::is_same_v<T, Vec2f>) return {x.x * w + y.x * u + z.x * v, x.y * w + y.y * u + z.y * v};
+    else if constexpr (std::is_same_v<T, Vec4f>)
+        return {x.x * w + y.x * u + z.x * v, x.y * w + y.y * u + z.y * v, x.z * w + y.z * u + z.z * v,
+                x.w * w + y.w * u + z.w * v};
+    else return x * w + y * u + z * v;
+}
+
+/// Texture lookup through a material's reference; (1,1,1,1) when the reference is empty.
+Vec4f lookup(const Scene& scene, const TextureRef& ref, const Vec2f uv[2]) {
+    if (!ref.valid() || size_t(ref.texture) >= scene.textures.size()) return {1.f, 1.f, 1.f, 1.f};
+    Vec2f t = uv[ref.uv_set > 1 ? 0 : ref.uv_set];
+    if (!ref.transform.identity()) t = apply_texture_transform(ref.transform, t);
+    return sample_texture(scene.textures[size_t(ref.texture)], t, 0.f);
+}
+
+}  // namespace
+
+SceneView::SceneView(const Scene& scene, const MappingOptions& mapping) : m_scene(scene), m_mapping(mapping) {
+    // Float transforms per instance; the normal matrix is inverted in double precision.
+    m_xf.resize(scene.instances.size());
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const Mat4d& w = scene.instances[i].world_from_object;
+        const Mat4d inv_t = w.inverse_affine().transposed();
+        for (int r = 0; r < 3; ++r) {
+            for (int c = 0; c < 4; ++c) m_xf[i].m[r * 4 + c] = float(w(r, c));
+            for (int c = 0; c < 3; ++c) m_xf[i].n[r * 3 + c] = float(inv_t(r, c));
+        }
+    }
+    // What each mesh needs from traversal.
+    m_mesh_flags.resize(scene.meshes.size());
+    for (size_t g = 0; g < scene.meshes.size(); ++g) {
+        const Material& m = scene.materials[scene.meshes[g].material];
+        uint32_t f = 0;
+        const bool cutout = m.model == MaterialModel::GltfPbr && m.alpha_mode == AlphaMode::Mask;
+        const bool single_sided = m.model == MaterialModel::GltfPbr && !m.double_sided;
+        if (cutout || single_sided) f |= kNeedsAccept;
+        const bool transmissive = m.model == MaterialModel::Classic ? !is_black(m.classic.kt)
+                                                                    : (m.transmission > 0.f || m.transmission_texture.valid() ||
+                                                                       m.alpha_mode == AlphaMode::Blend);
+        if (cutout || transmissive) f |= kNeedsTransmittance;
+        m_mesh_flags[g] = f;
+    }
+}
+
+Vec3f SceneView::world_geometric_normal(const Hit& hit) const {
+    const Mesh& mesh = m_scene.meshes[hit.geom];
+    const InstanceXf& xf = m_xf[hit.inst];
+    const uint32_t* idx = &mesh.indices[size_t(hit.prim) * 3];
+    Vec3f p0 = xf_point(xf.m, mesh.positions[idx[0]]);
+    Vec3f p1 = xf_point(xf.m, mesh.positions[idx[1]]);
+    Vec3f p2 = xf_point(xf.m, mesh.positions[idx[2]]);
+    return cross(p1 - p0, p2 - p0);
+}
+
+SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit) const {
+    SurfacePoint sp;
+    const Mesh& mesh = m_scene.meshes[hit.geom];
+    const InstanceXf& xf = m_xf[hit.inst];
+    const uint32_t i0 = mesh.indices[size_t(hit.prim) * 3 + 0];
+    const uint32_t i1 = mesh.indices[size_t(hit.prim) * 3 + 1];
+    const uint32_t i2 = mesh.indices[size_t(hit.prim) * 3 + 2];
+    const float u = hit.u, v = hit.v, w = 1.f - hit.u - hit.v;
+    sp.material = mesh.material;
+
+    // Position from the world-space vertices (not o + t d): accurate enough for ulp offsets.
+    const Vec3f p0 = xf_point(xf.m, mesh.positions[i0]);
+    const Vec3f p1 = xf_point(xf.m, mesh.positions[i1]);
+    const Vec3f p2 = xf_point(xf.m, mesh.positions[i2]);
+    sp.p = p0 * w + p1 * u + p2 * v;
+    Vec3f ng = normalize(cross(p1 - p0, p2 - p0));
+    if (ng == Vec3f(0.f)) ng = normalize(-ray.dir);  // degenerate triangle: face the ray
+    sp.ng = ng;
+
+    if (!mesh.uv0.empty()) sp.uv[0] = interpolate(mesh.uv0, i0, i1, i2, u, v);
+    if (!mesh.uv1.empty()) sp.uv[1] = interpolate(mesh.uv1, i0, i1, i2, u, v);
+    if (!mesh.colors.empty()) sp.color = interpolate(mesh.colors, i0, i1, i2, u, v);
+
+    // Shading normal: interpolated vertex normals, then the normal map.
+    Vec3f ns = ng;
+    if (!mesh.normals.empty()) {
+        Vec3f n = normalize(xf_normal(xf.n, interpolate(mesh.normals, i0, i1, i2, u, v)));
+        if (n != Vec3f(0.f) && is_finite(n)) ns = n;
+    }
+    const Material& mat = m_scene.materials[mesh.material];
+    if (mat.normal_texture.valid() && !mesh.tangents.empty() && mat.model == MaterialModel::GltfPbr) {
+        Vec4f t4 = interpolate(mesh.tangents, i0, i1, i2, u, v);
+        Vec3f t = xf_vector(xf.m, t4.xyz());
+        t = normalize(t - ns * dot(ns, t));  // Gram-Schmidt against the shading normal
+        if (t != Vec3f(0.f)) {
+            Vec3f b = cross(ns, t) * (t4.w < 0.f ? -1.f : 1.f);
+            Vec4f tex = lookup(m_scene, mat.normal_texture, sp.uv);
+            float s = mat.normal_texture.scale;
+            Vec3f m{(tex.x * 2.f - 1.f) * s, (tex.y * 2.f - 1.f) * s, tex.z * 2.f - 1.f};
+            Vec3f mapped = normalize(t * m.x + b * m.y + ns * m.z);
+            if (mapped != Vec3f(0.f) && is_finite(mapped)) ns = mapped;
+        }
+    }
+    sp.ns = ns;
+    return sp;
+}
+
+PbrSample SceneView::material_inputs(const Material& m, const SurfacePoint& sp) const {
+    PbrSample s;
+    Vec4f bc = lookup(m_scene, m.base_color_texture, sp.uv);
+    s.base_color = {m.base_color.x * bc.x * sp.color.x, m.base_color.y * bc.y * sp.color.y,
+                    m.base_color.z * bc.z * sp.color.z, m.base_color.w * bc.w * sp.color.w};
+    Vec4f mr = lookup(m_scene, m.metallic_roughness_texture, sp.uv);
+    s.metallic = std::clamp(m.metallic * mr.z, 0.f, 1.f);
+    s.roughness = std::clamp(m.roughness * mr.y, 0.f, 1.f);
+    s.transmission = std::clamp(m.transmission * lookup(m_scene, m.transmission_texture, sp.uv).x, 0.f, 1.f);
+    if (m.occlusion_texture.valid()) {
+        float occ = lookup(m_scene, m.occlusion_texture, sp.uv).x;
+        s.occlusion = 1.f + m.occlusion_texture.scale * (occ - 1.f);
+    }
+    Vec4f em = lookup(m_scene, m.emissive_texture, sp.uv);
+    s.emissive = m.emissive * em.xyz() * m.emissive_strength;
+    s.specular = m.specular * lookup(m_scene, m.specular_texture, sp.uv).w;
+    s.specular_color = m.specular_color * lookup(m_scene, m.specular_color_texture, sp.uv).xyz();
+    return s;
+}
+
+WhittedCoeffs SceneView::coefficients(const SurfacePoint& sp) const {
+    const Material& m = m_scene.materials[sp.material];
+    if (m.model == MaterialModel::Classic) return m.classic;
+    return map_gltf_material(m, material_inputs(m, sp), m_mapping);
+}
+
+float SceneView::alpha_at(const Material& m, const Hit& hit) const {
+    const Mesh& mesh = m_scene.meshes[hit.geom];
+    const uint32_t i0 = mesh.indices[size_t(hit.prim) * 3 + 0];
+    const uint32_t i1 = mesh.indices[size_t(hit.prim) * 3 + 1];
+    const uint32_t i2 = mesh.indices[size_t(hit.prim) * 3 + 2];
+    Vec2f uv[2];
+    if (!mesh.uv0.empty()) uv[0] = interpolate(mesh.uv0, i0, i1, i2, hit.u, hit.v);
+    if (!mesh.uv1.empty()) uv[1] = interpolate(mesh.uv1, i0, i1, i2, hit.u, hit.v);
+    float a = m.base_color.w * lookup(m_scene, m.base_color_texture, uv).w;
+    if (!mesh.colors.empty()) a *= interpolate(mesh.colors, i0, i1, i2, hit.u, hit.v).w;
+    return std::clamp(a, 0.f, 1.f);
+}
+
+bool SceneView::accept(const Ray& ray, const Hit& hit, RayKind kind) const {
+    const Material& m = m_scene.materials[m_scene.meshes[hit.geom].material];
+    if (m.model != MaterialModel::GltfPbr) return true;
+    if (m.alpha_mode == AlphaMode::Mask && alpha_at(m, hit) < m.alpha_cutoff) return false;
+    // Back faces of single-sided materials are culled for camera rays only: culling secondary or
+    // shadow rays would let light leak through closed meshes.
+    if (kind == RayKind::Camera && !m.double_sided && dot(world_geometric_normal(hit), ray.dir) > 0.f) return false;
+    return true;
+}
+
+Color SceneView::transmittance(const Ray& ray, const Hit& hit) const {
+    const Material& m = m_scene.materials[m_scene.meshes[hit.geom].material];
+    if (m.model == MaterialModel::Classic) return m.classic.kt;
+    float coverage = 1.f;
+    if (m.alpha_mode == AlphaMode::Mask) {
+        if (alpha_at(m, hit) < m.alpha_cutoff) return Color(1.f);
+    } else if (m.alpha_mode == AlphaMode::Blend) {
+        coverage = alpha_at(m, hit);
+    }
+    Color kt(0.f);
+    if (m.transmission > 0.f) {
+        SurfacePoint sp = surface(ray, hit);
+        kt = map_gltf_material(m, material_inputs(m, sp), m_mapping).kt;
+    }
+    // BLEND: the uncovered fraction passes untouched, the covered part passes through Kt.
+    return Color(1.f - coverage) + kt * coverage;
+}
+
+}  // namespace whitted

@@ -1,0 +1,57 @@
+// SceneView: the render-time view of a Scene. Precomputes per-instance float transforms and
+// per-mesh flags, turns a minimal Hit into a SurfacePoint (position, normals, UVs, colors) and
+// evaluates materials there. It is also the SurfaceFilter backends consult during traversal.
+#pragma once
+
+#include <vector>
+
+#include "renderer/accel/accelerator.h"
+#include "renderer/scene/scene.h"
+#include "shading/material_mapping.h"
+
+namespace whitted {
+
+/// Everything the integrator needs about one hit point (world space).
+struct SurfacePoint {
+    Vec3f p;                    ///< position, interpolated from the triangle's world-space vertices
+    Vec3f ng;                   ///< unit geometric normal (front side by winding)
+    Vec3f ns;                   ///< unit shading normal (interpolated, normal-mapped), front side
+    Vec2f uv[2];                ///< TEXCOORD_0/1 (0 when absent)
+    Vec4f color{1.f, 1.f, 1.f, 1.f};  ///< COLOR_0 (1 when absent)
+    uint32_t material = 0;
+};
+
+class SceneView final : public SurfaceFilter {
+public:
+    SceneView(const Scene& scene, const MappingOptions& mapping);
+
+    /// Full surface data at a hit of `ray`.
+    SurfacePoint surface(const Ray& ray, const Hit& hit) const;
+    /// Material inputs at a point (factors x textures x vertex color).
+    PbrSample material_inputs(const Material& material, const SurfacePoint& sp) const;
+    /// The seed's coefficients at a point.
+    WhittedCoeffs coefficients(const SurfacePoint& sp) const;
+    const Scene& scene() const { return m_scene; }
+    const MappingOptions& mapping() const { return m_mapping; }
+
+    // SurfaceFilter
+    bool accept(const Ray& ray, const Hit& hit, RayKind kind) const override;
+    Color transmittance(const Ray& ray, const Hit& hit) const override;
+    uint32_t mesh_flags(uint32_t geom) const override { return m_mesh_flags[geom]; }
+
+private:
+    /// Coverage alpha at a hit (base color alpha x texture x vertex alpha), UV0/UV1 interpolated.
+    float alpha_at(const Material& m, const Hit& hit) const;
+    Vec3f world_geometric_normal(const Hit& hit) const;
+
+    struct InstanceXf {
+        float m[12];            ///< world_from_object, row-major 3x4
+        float n[9];             ///< normal matrix (inverse transpose of the 3x3 part), row-major
+    };
+    const Scene& m_scene;
+    MappingOptions m_mapping;
+    std::vector<InstanceXf> m_xf;
+    std::vector<uint32_t> m_mesh_flags;
+};
+
+}  // namespace whitted
