@@ -1,21 +1,37 @@
 // Texture lookups: wrap modes, nearest/bilinear filtering, MIP selection, KHR_texture_transform.
+//
+// Every lookup is pure (no allocation, no shared mutable state), so any number of threads may
+// sample the same Texture. Texels are 8-bit; sRGB textures are decoded per texel through a
+// 256-entry table before filtering, so results are always linear RGBA (alpha is never decoded).
 #pragma once
+
+#include <cstdint>
 
 #include "renderer/scene/scene.h"
 
 namespace whitted {
 
-/// Applies KHR_texture_transform (uv' = T * R * S * uv).
+/// Applies KHR_texture_transform: uv' = offset + R(rotation) * (scale * uv) with
+/// R(a) * (u, v) = (cos a * u + sin a * v, -sin a * u + cos a * v) (see docs/materials.md).
 Vec2f apply_texture_transform(const TextureTransform& xf, Vec2f uv);
 
 /// Linear RGBA at uv; `lod` is the MIP level (0 = full resolution, fractional = trilinear when
 /// the texture uses mips). sRGB textures are decoded to linear before filtering.
+/// lod <= 0 filters with mag_filter, lod > 0 with min_filter; non-finite uv or lod count as 0.
+/// A texture without levels returns (1, 1, 1, 1).
 Vec4f sample_texture(const Texture& texture, Vec2f uv, float lod = 0.f);
 
 /// Fills texture.levels[1..] from levels[0] by 2x2 box filtering in linear space.
+/// Each level is max(1, floor(size / 2)) of the previous one, down to 1x1. Each destination
+/// texel averages the source texels its footprint covers, weighted by overlap: exactly the 2x2
+/// box for even sizes, and no texel dropped for odd ones (5 -> 2: weights 1, 1, 1/2 | 1/2, 1, 1).
+/// Existing levels[1..] are replaced; deterministic.
 void build_mip_levels(Texture& texture);
 
-/// sRGB transfer -> linear for an 8-bit value (table lookup).
+/// sRGB transfer -> linear for an 8-bit value (table lookup, exact IEC 61966-2-1 curve).
 float srgb8_to_linear(uint8_t v);
+
+/// Linear -> sRGB transfer, rounded to the nearest 8-bit code; input clamped to [0, 1], NaN -> 0.
+uint8_t linear_to_srgb8(float v);
 
 }  // namespace whitted

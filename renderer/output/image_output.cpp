@@ -19,6 +19,7 @@
 #include <optional>
 #include <string_view>
 #include <system_error>
+#include <utility>
 
 #include <unistd.h>
 
@@ -359,36 +360,53 @@ EncodedImage encode_display(const Film& film, FileKind kind, const OutputSetting
     return image;
 }
 
-/// Writes `image` to "<dir>/.<stem>.tmp-<pid><ext>" and renames it to `path`; on failure the
-/// temporary file is removed and whitted::Error("<path>: <reason>") is thrown.
+/// Removes a temporary file when it goes out of scope, unless released (after the rename).
+class TempFileGuard {
+public:
+    explicit TempFileGuard(fs::path path) : m_path(std::move(path)) {}
+    ~TempFileGuard() {
+        if (m_active) {
+            std::error_code ignored;
+            fs::remove(m_path, ignored);
+        }
+    }
+    TempFileGuard(const TempFileGuard&) = delete;
+    TempFileGuard& operator=(const TempFileGuard&) = delete;
+    const fs::path& path() const { return m_path; }
+    void release() { m_active = false; }
+
+private:
+    fs::path m_path;
+    bool m_active = true;
+};
+
+/// Writes `image` to "<dir>/.<stem>.tmp-<pid><ext>" and renames it to `path`; on any failure
+/// (including exceptions) the temporary file is removed; errors are whitted::Error("<path>: <reason>").
 void write_atomically(const EncodedImage& image, FileKind kind, const fs::path& path) {
     const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
     std::error_code ec;
     if (!fs::is_directory(dir, ec))
         throw Error(fmt::format("{}: directory '{}' does not exist", path.string(), dir.string()));
+    auto fail = [&](const std::string& reason) { return Error(fmt::format("{}: {}", path.string(), reason)); };
 
     // The real extension stays last so that every tool recognises the temporary file's format.
-    const fs::path temp =
-        dir / fmt::format(".{}.tmp-{}{}", path.stem().string(), long(::getpid()), path.extension().string());
-    auto fail = [&](const std::string& reason) {
-        std::error_code ignored;
-        fs::remove(temp, ignored);
-        return Error(fmt::format("{}: {}", path.string(), reason));
-    };
-
-    auto out = OIIO::ImageOutput::create(oiio_format_name(kind));
-    if (!out) throw fail(OIIO::geterror());
-    if (!out->open(temp.string(), image.spec)) throw fail(out->geterror());
-    if (!out->write_image(image.format, image.bytes.data())) {
-        std::string reason = out->geterror();
-        out->close();
-        throw fail(reason);
+    TempFileGuard temp(dir / fmt::format(".{}.tmp-{}{}", path.stem().string(), long(::getpid()),
+                                         path.extension().string()));
+    {
+        auto out = OIIO::ImageOutput::create(oiio_format_name(kind));
+        if (!out) throw fail(OIIO::geterror());
+        if (!out->open(temp.path().string(), image.spec)) throw fail(out->geterror());
+        if (!out->write_image(image.format, image.bytes.data())) {
+            std::string reason = out->geterror();
+            out->close();
+            throw fail(reason);
+        }
+        if (!out->close()) throw fail(out->geterror());
     }
-    if (!out->close()) throw fail(out->geterror());
-    out.reset();
 
-    fs::rename(temp, path, ec);
-    if (ec) throw fail(fmt::format("cannot rename '{}': {}", temp.string(), ec.message()));
+    fs::rename(temp.path(), path, ec);
+    if (ec) throw fail(fmt::format("cannot rename '{}': {}", temp.path().string(), ec.message()));
+    temp.release();
 }
 
 }  // namespace

@@ -144,6 +144,20 @@ TEST(IntegratorAnalytic, ShadowThroughThinTransparentOccluderIsKt) {
     expect_color_near(render_pixel(s, 1, 1, 0, 0), Color(0.05f) + Color(0.5f) * glass.kt);
 }
 
+TEST(IntegratorAnalytic, DuplicateReportsOfOneCrossingCountOnce) {
+    // The same quad stored twice in one mesh: the shadow ray meets two primitives of one
+    // (mesh, instance) at the same t, which is one surface crossing (as when Embree reports a
+    // primitive twice or both triangles of a shared edge). Without de-duplication: Kt^2.
+    Scene s = shadow_scene(0.5f);
+    WhittedCoeffs glass;
+    glass.kt = Color(0.5f);
+    Mesh quad = make_quad({-0.5f, -0.4f, 2}, {0.5f, -0.4f, 2}, {0.5f, 0.6f, 2}, {-0.5f, 0.6f, 2},
+                          add_classic_material(s, glass));
+    quad.indices.insert(quad.indices.end(), {0, 1, 2, 0, 2, 3});
+    add_mesh(s, quad);
+    expect_color_near(render_pixel(s, 1, 1, 0, 0), Color(0.05f) + Color(0.5f) * glass.kt);
+}
+
 TEST(IntegratorAnalytic, ShadowThroughClosedTransparentOccluderIsKtSquared) {
     Scene s = shadow_scene(0.5f);
     WhittedCoeffs glass;

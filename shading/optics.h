@@ -1,0 +1,33 @@
+// Directions at a surface: mirror reflection and Snell refraction (Whitted 1980), Schlick Fresnel.
+#pragma once
+
+#include <cmath>
+#include <optional>
+
+#include "renderer/core/vecmath.h"
+
+namespace whitted {
+
+/// Mirror direction of the unit vector V (pointing away from the surface) about the unit normal N:
+/// R = 2 (N.V) N - V.
+inline Vec3f reflect(const Vec3f& V, const Vec3f& N) { return N * (2.f * dot(N, V)) - V; }
+
+/// Refracted direction for unit incident direction I (travelling toward the surface), unit normal
+/// N on the incident side (dot(I, N) < 0) and eta = n_incident / n_transmitted. Returns nothing on
+/// total internal reflection.
+inline std::optional<Vec3f> refract(const Vec3f& I, const Vec3f& N, float eta) {
+    float cos_i = -dot(N, I);
+    float sin2_t = eta * eta * std::max(0.f, 1.f - cos_i * cos_i);
+    if (sin2_t >= 1.f) return std::nullopt;  // total internal reflection
+    float cos_t = std::sqrt(1.f - sin2_t);
+    return normalize(I * eta + N * (eta * cos_i - cos_t));
+}
+
+/// Schlick's approximation of the Fresnel reflectance for normal-incidence reflectance f0.
+inline Color schlick(const Color& f0, float cos_theta) {
+    float c = std::clamp(1.f - cos_theta, 0.f, 1.f);
+    float c5 = c * c * c * c * c;
+    return f0 + (Color(1.f) - f0) * c5;
+}
+
+}  // namespace whitted

@@ -1,0 +1,137 @@
+// The `whitted` program end to end: exit codes, one-line errors, outputs written.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+    int code = -1;
+    std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+/// Runs the whitted executable with `args` (shell-quoted by the caller).
+Result run(const std::string& args) {
+    static int counter = 0;
+    const fs::path dir = fs::temp_directory_path() / ("whitted_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path out = dir / ("out" + std::to_string(counter) + ".txt");
+    const fs::path err = dir / ("err" + std::to_string(counter++) + ".txt");
+    const std::string cmd = std::string("'") + WHITTED_EXE + "' " + args + " >'" + out.string() + "' 2>'" +
+                            err.string() + "' </dev/null";
+    const int status = std::system(cmd.c_str());
+    Result r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+}
+
+size_t line_count(const std::string& s) {
+    size_t n = 0;
+    for (char c : s) n += c == '\n';
+    return n;
+}
+
+const std::string kBox = std::string(WHITTED_ASSETS_DIR) + "/gltf/Box/glTF-Binary/Box.glb";
+
+TEST(Cli, UnknownFlagIsOneLineAndExitTwo) {
+    Result r = run("render '" + kBox + "' --no-such-flag");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("--no-such-flag"), std::string::npos) << r.err;
+}
+
+TEST(Cli, BadFlagValueIsOneLineAndExitTwo) {
+    Result r = run("render '" + kBox + "' --max-depth -3");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    r = run("render '" + kBox + "' --log-level loud");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+}
+
+TEST(Cli, MissingSubcommandOrFileIsExitTwo) {
+    EXPECT_EQ(run("").code, 2);
+    EXPECT_EQ(run("render").code, 2);
+}
+
+TEST(Cli, MissingSceneFileIsOneLineNamingIt) {
+    Result r = run("render /nonexistent/scene.gltf -o /tmp/x.png");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("/nonexistent/scene.gltf"), std::string::npos) << r.err;
+}
+
+TEST(Cli, BrokenGltfIsOneLineNamingTheFile) {
+    const std::string bad = std::string(WHITTED_TEST_DATA_DIR) + "/gltf-invalid/validator/node/node_loop.gltf";
+    Result r = run("info '" + bad + "'");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("node_loop.gltf"), std::string::npos) << r.err;
+}
+
+TEST(Cli, BadCameraIndexAndCropAreErrors) {
+    Result r = run("render '" + kBox + "' --camera 7 -o /tmp/whitted_cli_cam.png --no-progress");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("--camera 7"), std::string::npos) << r.err;
+    r = run("render '" + kBox + "' --crop 1,2,3 -o /tmp/whitted_cli_crop.png --no-progress");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("--crop"), std::string::npos) << r.err;
+}
+
+TEST(Cli, UnknownOutputExtensionIsAnErrorAndWritesNothing) {
+    const fs::path out = fs::temp_directory_path() / "whitted_cli_out.xyz";
+    fs::remove(out);
+    Result r = run("render '" + kBox + "' --width 16 --no-progress -o '" + out.string() + "'");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("whitted_cli_out.xyz"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Cli, RenderWritesPngAndExrWithAovsAndPrintsStats) {
+    const fs::path png = fs::temp_directory_path() / "whitted_cli_box.png";
+    const fs::path exr = fs::temp_directory_path() / "whitted_cli_box.exr";
+    fs::remove(png);
+    fs::remove(exr);
+    Result r = run("render '" + kBox + "' --width 48 --no-progress -o '" + png.string() + "'");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(png));
+    EXPECT_NE(r.err.find("Mrays/s"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("shadow"), std::string::npos) << r.err;
+    r = run("render '" + kBox + "' --width 48 --height 20 --no-progress --aov depth,normal -o '" + exr.string() + "'");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(exr));
+}
+
+TEST(Cli, HelpDocumentsFlagsWithDefaults) {
+    Result r = run("render --help");
+    EXPECT_EQ(r.code, 0);
+    for (const char* flag : {"--max-depth", "--background", "--ambient", "--exposure", "--camera", "--aov", "--crop",
+                             "--threads", "--view", "--fresnel", "--refract-thin", "--width", "--height"})
+        EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
+    EXPECT_NE(r.out.find("=5"), std::string::npos) << "max-depth default shown";
+}
+
+TEST(Cli, InfoPrintsCounts) {
+    Result r = run("info '" + kBox + "'");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("12"), std::string::npos) << r.out;  // 12 triangles
+}
+
+}  // namespace

@@ -1,0 +1,96 @@
+// The image must be bit-identical for any thread count and any tile size (including tile sizes
+// that do not divide the image), also with glass, mirrors and transparent shadows.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "renderer/integrator/render.h"
+#include "tests/support/scene_builder.h"
+
+namespace whitted {
+namespace {
+
+using namespace whitted::test;
+
+/// Floor, a mirror box, a refracting glass box, a thin tinted panel, two lights.
+Scene glass_and_shadows_scene() {
+    Scene s;
+    WhittedCoeffs floor;
+    floor.kd = floor.ka = Color(0.6f, 0.55f, 0.5f);
+    floor.ks = Color(0.1f);
+    floor.n = 20.f;
+    add_mesh(s, make_quad({-10, -10, 0}, {10, -10, 0}, {10, 10, 0}, {-10, 10, 0}, add_classic_material(s, floor)));
+    WhittedCoeffs mirror;
+    mirror.kr = Color(0.8f);
+    mirror.kd = mirror.ka = Color(0.1f);
+    add_mesh(s, make_box({-2.5f, -0.5f, 0}, {-1.5f, 0.5f, 1.5f}, add_classic_material(s, mirror)));
+    WhittedCoeffs glass;
+    glass.kt = Color(0.9f);
+    glass.kr = Color(0.05f);
+    glass.ior = 1.5f;
+    glass.thin = false;
+    add_mesh(s, make_box({-0.5f, -0.5f, 0}, {0.5f, 0.5f, 1.2f}, add_classic_material(s, glass)));
+    WhittedCoeffs tint;
+    tint.kt = Color(0.9f, 0.3f, 0.2f);
+    tint.kd = tint.ka = Color(0.05f);
+    add_mesh(s, make_quad({1.5f, -0.5f, 0.2f}, {2.5f, -0.5f, 0.2f}, {2.5f, 0.5f, 1.2f}, {1.5f, 0.5f, 1.2f},
+                          add_classic_material(s, tint)));
+    s.lights.push_back(point_light({2, -3, 5}, 30.f, {1.f, 0.9f, 0.8f}));
+    s.lights.push_back(point_light({-3, -2, 4}, 15.f, {0.6f, 0.7f, 1.f}));
+    s.cameras.push_back(make_camera(CameraType::Perspective, {0, -7, 3.5}, {0, 7, -3}, {0, 0, 1}, 0.7));
+    return s;
+}
+
+Film render(const Scene& s, int threads, int tile) {
+    RenderSettings rs;
+    rs.width = 97;  // odd on purpose: no tile size below divides it
+    rs.height = 61;
+    rs.threads = threads;
+    rs.tile_size = tile;
+    rs.aovs = AovSet{true, true, true, true, true};
+    Renderer r(s, rs);
+    return r.render();
+}
+
+bool bit_identical(const Film& a, const Film& b) {
+    return a.beauty.size() == b.beauty.size() &&
+           std::memcmp(a.beauty.data(), b.beauty.data(), a.beauty.size() * sizeof(Color)) == 0 &&
+           std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * sizeof(float)) == 0 &&
+           std::memcmp(a.normal.data(), b.normal.data(), a.normal.size() * sizeof(Vec3f)) == 0 &&
+           a.prim_id == b.prim_id && a.inst_id == b.inst_id;
+}
+
+TEST(Determinism, ThreadCountAndTileSizeDoNotChangeTheImage) {
+    const Scene s = glass_and_shadows_scene();
+    const Film reference = render(s, 1, 32);
+    // The scene really has glass, reflections and tinted shadows: the image is not trivial.
+    RenderSettings rs;
+    rs.width = 97;
+    rs.height = 61;
+    RenderStats stats;
+    Renderer(s, rs).render(&stats);
+    EXPECT_GT(stats.rays.refraction, 100u);
+    EXPECT_GT(stats.rays.reflection, 100u);
+    EXPECT_GT(stats.rays.shadow, 1000u);
+
+    for (auto [threads, tile] : {std::pair{8, 32}, std::pair{2, 7}, std::pair{8, 13}, std::pair{3, 1}, std::pair{8, 200}})
+        EXPECT_TRUE(bit_identical(reference, render(s, threads, tile))) << threads << " threads, tile " << tile;
+}
+
+TEST(Determinism, CropRendersTheSamePixelsAsTheFullImage) {
+    const Scene s = glass_and_shadows_scene();
+    const Film full = render(s, 2, 16);
+    RenderSettings rs;
+    rs.width = 97;
+    rs.height = 61;
+    rs.threads = 2;
+    rs.crop = PixelWindow{10, 5, 60, 40};
+    Film crop = Renderer(s, rs).render();
+    ASSERT_EQ(crop.width(), 50);
+    ASSERT_EQ(crop.height(), 35);
+    for (int y = 5; y < 40; ++y)
+        for (int x = 10; x < 60; ++x) ASSERT_EQ(crop.beauty[crop.index(x, y)], full.beauty[full.index(x, y)]);
+}
+
+}  // namespace
+}  // namespace whitted
