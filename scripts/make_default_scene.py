@@ -111,7 +111,6 @@ def read_gltf(path):
         data = f.read()
     bin_chunk = None
     if data[:4] == b"glTF":
-        _, _, _ = struct.unpack_from("<III", data, 0)
         offset = 12
         doc = None
         while offset < len(data):
@@ -319,18 +318,26 @@ class Document:
         # is ours); everything else is rebased.
         root = self.add_node({"name": name, "translation": rnd_list(translation),
                               "rotation": rnd_list(rotation, 7), "scale": rnd_list(scale)})
-        node_base = len(j["nodes"])
-        for n in src.get("nodes", []):
-            n = dict(n)
-            n.pop("camera", None)
+        src_nodes = [dict(n) for n in src.get("nodes", [])]
+        for n in src_nodes:
             n.pop("skin", None)
+            if n.pop("camera", None) is not None and "mesh" not in n and not n.get("children"):
+                n["_drop"] = True  # a camera-only leaf would be left empty
+        remap, next_index = {}, len(j["nodes"])
+        for i, n in enumerate(src_nodes):
+            if not n.get("_drop"):
+                remap[i] = next_index
+                next_index += 1
+        for i, n in enumerate(src_nodes):
+            if n.get("_drop"):
+                continue
             if "mesh" in n:
                 n["mesh"] += mesh_base
             if "children" in n:
-                n["children"] = [c + node_base for c in n["children"]]
+                n["children"] = [remap[c] for c in n["children"] if c in remap]
             j["nodes"].append(n)
         scene = src["scenes"][src.get("scene", 0)]
-        j["nodes"][root]["children"] = [c + node_base for c in scene["nodes"]]
+        j["nodes"][root]["children"] = [remap[c] for c in scene["nodes"] if c in remap]
         return root
 
     def write_glb(self, path):
@@ -439,7 +446,7 @@ def png_rgb(width, height, pixel):
             + chunk(b"IDAT", zlib.compress(bytes(raw), 9)) + chunk(b"IEND", b""))
 
 
-def checker_png(size=64, light=(214, 206, 190), dark=(58, 64, 74)):
+def checker_png(size=64, light=(204, 196, 180), dark=(58, 64, 74)):
     half = size // 2
     return png_rgb(size, size, lambda x, y: light if (x < half) == (y < half) else dark)
 
@@ -463,9 +470,9 @@ def build():
     doc = Document()
 
     # Camera first: the renderer uses the first camera in node order.
-    eye, target = [0.12, 0.44, 1.25], [0.0, 0.11, -0.05]
+    eye, target = [0.08, 0.46, 1.0], [0.03, 0.12, -0.12]
     doc.j["cameras"].append({"name": "view", "type": "perspective", "perspective": {
-        "aspectRatio": 1.5, "yfov": 0.56, "znear": 0.01, "zfar": 100.0}})
+        "aspectRatio": 1.5, "yfov": 0.6, "znear": 0.01, "zfar": 100.0}})
     doc.add_node({"name": "camera", "camera": 0, "translation": rnd_list(eye),
                   "rotation": rnd_list(look_at_quat(eye, target), 7)})
 
@@ -477,9 +484,9 @@ def build():
     side_mat = doc.add_material(pbr("wall_side", (0.75, 0.62, 0.42)))
     white_mat = doc.add_material(pbr("wall_white", (0.78, 0.78, 0.76)))
     X, Y, Z = [1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]
-    NX, NY, NZ = [-1.0, 0, 0], [0, -1.0, 0], [0, 0, -1.0]
-    room_w, room_d, room_h = 2.4, 3.2, 1.6     # x in [-1.2, 1.2], z in [-0.9, 2.3]
-    z0, z1 = -0.9, 2.3
+    NX, NZ = [-1.0, 0, 0], [0, 0, -1.0]
+    room_w, room_d, room_h = 2.4, 3.5, 1.6     # x in [-1.2, 1.2], z in [-1.2, 2.3]
+    z0, z1 = -1.2, 2.3
     zc, x0, x1 = (z0 + z1) / 2, -room_w / 2, room_w / 2
     # floor: normal +Y = u x v with u = +X, v = -Z; one check = 0.1 m (texture holds 2x2)
     pieces = [
@@ -498,7 +505,7 @@ def build():
     r_m = 0.13
     p, n, t, i = uv_sphere([0, 0, 0], r_m)
     doc.add_node({"name": "mirror_sphere", "mesh": doc.add_mesh("mirror_sphere", p, n, t, i, mirror_mat),
-                  "translation": [-0.33, r_m, -0.12]})
+                  "translation": [-0.3, r_m, -0.2]})
 
     # Solid glass sphere: transmission + volume -> refraction with ior 1.5, faint blue absorption.
     doc.use_extension("KHR_materials_transmission")
@@ -509,40 +516,42 @@ def build():
         "KHR_materials_volume": {"thicknessFactor": 0.16, "attenuationColor": [0.8, 0.9, 1.0],
                                  "attenuationDistance": 0.3},
         "KHR_materials_ior": {"ior": 1.5}}))
-    r_g = 0.08
+    r_g = 0.09
     p, n, t, i = uv_sphere([0, 0, 0], r_g)
     doc.add_node({"name": "glass_sphere", "mesh": doc.add_mesh("glass_sphere", p, n, t, i, glass_mat),
-                  "translation": [0.02, r_g, 0.2]})
+                  "translation": [0.2, r_g, -0.1]})
 
     # Thin red transparent panel (no volume: thin-walled, straight through, tints light and shadows).
-    panel_mat = doc.add_material(pbr("red_filter", (1.0, 0.3, 0.2), roughness=0.05, extensions={
+    panel_mat = doc.add_material(pbr("red_filter", (1.0, 0.2, 0.12), roughness=0.05, extensions={
         "KHR_materials_transmission": {"transmissionFactor": 1.0}}))
     pw, ph = 0.2, 0.26
-    yaw = math.radians(-35)
+    yaw = math.radians(-32)
     u_axis = [math.cos(yaw), 0.0, -math.sin(yaw)]
     p, n, t, i = two_sided_quad([0, ph / 2, 0], u_axis, Y, pw / 2, ph / 2, 0.004)
     doc.add_node({"name": "red_panel", "mesh": doc.add_mesh("red_panel", p, n, t, i, panel_mat),
-                  "translation": [-0.12, 0.0, 0.02]})
+                  "translation": [-0.12, 0.0, 0.1]})
 
     # Real assets. GlassHurricaneCandleHolder is kept at its native scale (0.27 m tall) because
-    # its attenuationDistance is given in world units; the Duck (about 1.6 units at 0.01) is
-    # scaled to about 0.2 m.
+    # its attenuationDistance is given in world units. The Duck (mesh y in [9.9, 164] under its
+    # own 0.01 scale) is scaled by 0.13 to about 0.2 m, lowered onto the floor and turned so
+    # its beak (+X in the asset) points towards the front-left.
     doc.merge(os.path.join(REPO, "assets/gltf/GlassHurricaneCandleHolder/glTF-Binary/GlassHurricaneCandleHolder.glb"),
-              "GlassHurricaneCandleHolder", [0.05, 0.0, -0.32], [0, 0, 0, 1], [1, 1, 1])
+              "GlassHurricaneCandleHolder", [0.0, 0.0, -0.38], [0, 0, 0, 1], [1, 1, 1])
     doc.merge(os.path.join(REPO, "assets/gltf/Duck/glTF-Binary/Duck.glb"),
-              "Duck", [0.33, 0.0, -0.02], quat_axis_angle(Y, 70), [0.13, 0.13, 0.13])
+              "Duck", [0.4, -0.0129, -0.15], quat_axis_angle(Y, -120), [0.13, 0.13, 0.13])
 
-    # Lights: warm key spot from front-left above, cool fill point from the right, and a dim
-    # directional from above-behind for a third set of shadows.
-    key_pos, key_aim = [-0.75, 1.1, 0.75], [0.0, 0.05, -0.1]
-    doc.add_light({"type": "spot", "color": [1.0, 0.86, 0.7], "intensity": 3.2,
+    # Lights (all inside the closed room: a directional light would be blocked by the ceiling).
+    # Warm key spot from the left casts the long shadows to the right (the red one included);
+    # a point light high behind-right casts a second set towards the camera; a weak cool fill
+    # from the front-right lifts the faces the camera sees. Floor irradiance is about 1.
+    key_pos, key_aim = [-0.95, 0.85, 0.05], [0.05, 0.05, -0.05]
+    doc.add_light({"type": "spot", "color": [1.0, 0.86, 0.7], "intensity": 1.5,
                    "spot": {"innerConeAngle": 0.35, "outerConeAngle": 0.6}},
                   "key_spot", key_pos, look_at_quat(key_pos, key_aim))
-    doc.add_light({"type": "point", "color": [0.65, 0.78, 1.0], "intensity": 0.9},
-                  "fill_point", [0.85, 0.75, 0.45])
-    sun_from = [0.3, 1.0, -0.6]
-    doc.add_light({"type": "directional", "color": [1.0, 1.0, 1.0], "intensity": 0.35},
-                  "top_directional", [0.0, 1.5, 0.0], look_at_quat(sun_from, [0, 0, 0], (0, 0, -1)))
+    doc.add_light({"type": "point", "color": [0.65, 0.78, 1.0], "intensity": 0.25},
+                  "fill_point", [0.7, 0.7, 0.8])
+    doc.add_light({"type": "point", "color": [0.9, 0.95, 1.0], "intensity": 0.5},
+                  "back_point", [0.45, 1.25, -0.75])
     return doc
 
 
