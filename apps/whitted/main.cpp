@@ -223,6 +223,10 @@ int main(int argc, char** argv) {
     info->add_option("--scene", info_scene, "glTF scene index (-1 = the file's default scene)")->capture_default_str();
     info->add_flag("--no-textures", info_no_textures, "Skip decoding images");
 
+    // Global options (--log-level) may also follow the subcommand.
+    render->fallthrough();
+    info->fallthrough();
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
