@@ -1,1 +1,22 @@
-// placeholder: implemented in progress
+// Dispatch on the file extension (case-insensitive).
+
+#include "importers/scene_loader.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include "importers/located_error.h"
+#include "renderer/core/error.h"
+
+namespace whitted {
+
+Scene load_scene(const std::string& path, const ImportOptions& options) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext == ".gltf" || ext == ".glb") return import_gltf(path, options);
+    throw Error(file_loc(path),
+                ext.empty() ? std::string("file has no extension: cannot tell its format (supported: .gltf, .glb)")
+                            : "unsupported scene file extension '" + ext + "' (supported: .gltf, .glb)");
+}
+
+}  // namespace whitted

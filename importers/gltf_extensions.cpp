@@ -1,0 +1,76 @@
+// The extension table: Khronos registry (ratified and release-candidate KHR_) plus the common
+// EXT_/vendor extensions seen in the wild. Keep docs/gltf-support.md in step with it.
+
+#include "importers/gltf_extensions.h"
+
+#include <array>
+#include <string_view>
+
+namespace whitted::gltf {
+
+namespace {
+
+struct Entry {
+    std::string_view name;
+    ExtensionSupport support;
+    bool refuse_if_required;
+    std::string_view note;
+};
+
+constexpr ExtensionSupport S = ExtensionSupport::Supported;
+constexpr ExtensionSupport I = ExtensionSupport::Ignored;
+
+// refuse_if_required: true where ignoring the extension would lose data the file cannot be
+// shown without (compressed geometry, texture formats without a core fallback); false where
+// the file still renders recognisably without it (appearance layers, metadata).
+constexpr std::array kTable = {
+    Entry{"KHR_lights_punctual", S, false, "point, spot and directional lights (docs/lights.md)"},
+    Entry{"KHR_materials_emissive_strength", S, false, "emissiveStrength multiplies the emission"},
+    Entry{"KHR_materials_ior", S, false, "index of refraction"},
+    Entry{"KHR_materials_specular", S, false, "specular factor/color and their textures"},
+    Entry{"KHR_materials_transmission", S, false, "transmission factor and texture"},
+    Entry{"KHR_materials_unlit", S, false, "base color shown as is"},
+    Entry{"KHR_materials_volume", S, false,
+          "thicknessFactor > 0 makes a volume; attenuation color/distance; thickness texture not used"},
+    Entry{"KHR_mesh_quantization", S, false, "integer and normalized vertex attributes"},
+    Entry{"KHR_texture_transform", S, false, "offset, rotation, scale, texCoord override on every textureInfo"},
+    Entry{"EXT_mesh_gpu_instancing", S, false, "TRANSLATION/ROTATION/SCALE make one instance each"},
+    Entry{"KHR_materials_clearcoat", I, false, "clearcoat layer not rendered"},
+    Entry{"KHR_materials_sheen", I, false, "sheen not rendered"},
+    Entry{"KHR_materials_iridescence", I, false, "thin-film iridescence not rendered"},
+    Entry{"KHR_materials_anisotropy", I, false, "highlights stay isotropic"},
+    Entry{"KHR_materials_dispersion", I, false, "one index of refraction for all wavelengths"},
+    Entry{"KHR_materials_diffuse_transmission", I, false, "diffuse transmission not rendered"},
+    Entry{"KHR_materials_variants", I, false, "each primitive keeps its default material"},
+    Entry{"KHR_materials_pbrSpecularGlossiness", I, true, "core metallic-roughness values used instead"},
+    Entry{"KHR_xmp", I, false, "metadata not read"},
+    Entry{"KHR_xmp_json_ld", I, false, "metadata not read"},
+    Entry{"KHR_animation_pointer", I, false, "animations are not played"},
+    Entry{"KHR_texture_basisu", I, true, "KTX2/Basis images not decoded; the core texture source is used when present"},
+    Entry{"EXT_texture_webp", I, true, "WebP images not decoded; the core texture source is used when present"},
+    Entry{"EXT_texture_avif", I, true, "AVIF images not decoded; the core texture source is used when present"},
+    Entry{"MSFT_texture_dds", I, true, "DDS images not decoded; the core texture source is used when present"},
+    Entry{"KHR_draco_mesh_compression", I, true, "not decoded; the uncompressed fallback attributes are used"},
+    Entry{"EXT_meshopt_compression", I, true, "not decoded; the uncompressed fallback buffers are used"},
+    Entry{"EXT_lights_image_based", I, false, "no image-based lighting"},
+    Entry{"MSFT_lod", I, false, "the node's own (highest detail) mesh is used"},
+    Entry{"KHR_materials_volume_scatter", I, false, "no scattering inside volumes (attenuation only)"},
+    Entry{"KHR_node_visibility", I, true, "every node is shown"},
+    Entry{"EXT_lights_ies", I, false, "IES light profiles not read"},
+    Entry{"MSFT_packing_normalRoughnessMetallic", I, true, "packed textures not read; core textures used"},
+    Entry{"MSFT_packing_occlusionRoughnessMetallic", I, true, "packed textures not read; core textures used"},
+    Entry{"CESIUM_primitive_outline", I, false, "outlines not drawn"},
+    Entry{"ADOBE_materials_thin_transparency", I, false, "core / KHR_materials_transmission values used"},
+    Entry{"KHR_techniques_webgl", I, true, "custom shaders not supported"},
+    Entry{"KHR_materials_cmnBlinnPhong", I, true, "not supported"},
+};
+
+}  // namespace
+
+ExtensionPolicy extension_policy(const std::string& name) {
+    for (const Entry& e : kTable)
+        if (e.name == name) return {e.support, e.refuse_if_required, std::string(e.note), true};
+    return {ExtensionSupport::Ignored, true, "unknown extension", false};
+}
+
+}  // namespace whitted::gltf

@@ -1,0 +1,38 @@
+// Safe lookups in tinygltf::Value trees (extension objects tinygltf keeps as raw JSON).
+// Private to importers/. tinygltf's own Value::Get asserts on type mismatch; these never do.
+#pragma once
+
+#include <string>
+
+#include <tiny_gltf.h>
+
+namespace whitted::gltf {
+
+/// The member `key` of an extension map, or nullptr.
+inline const tinygltf::Value* find_extension(const tinygltf::ExtensionMap& extensions, const std::string& key) {
+    auto it = extensions.find(key);
+    return it == extensions.end() ? nullptr : &it->second;
+}
+
+/// The member `key` of a JSON object, or nullptr when `object` is not an object or lacks it.
+inline const tinygltf::Value* find_member(const tinygltf::Value* object, const std::string& key) {
+    if (object == nullptr || !object->IsObject() || !object->Has(key)) return nullptr;
+    return &object->Get(key);
+}
+
+/// Element `i` of a JSON array, or nullptr.
+inline const tinygltf::Value* find_element(const tinygltf::Value* array, size_t i) {
+    if (array == nullptr || !array->IsArray() || i >= array->ArrayLen()) return nullptr;
+    return &array->Get(int(i));
+}
+
+/// True for an integer-valued JSON number that fits an int (tinygltf may store 3 as 3.0).
+inline bool as_int(const tinygltf::Value* v, int& out) {
+    if (v == nullptr || !v->IsNumber()) return false;
+    const double d = v->GetNumberAsDouble();
+    if (!(d >= -2147483648.0 && d <= 2147483647.0) || d != double(int(d))) return false;
+    out = int(d);
+    return true;
+}
+
+}  // namespace whitted::gltf

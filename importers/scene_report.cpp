@@ -1,0 +1,200 @@
+// `whitted info`: what the importer made of a file, one greppable record per line.
+
+#include "importers/scene_report.h"
+
+#include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "shading/material_mapping.h"
+
+namespace whitted {
+
+namespace {
+
+std::string num(double v) {
+    if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+    if (std::isnan(v)) return "nan";
+    if (v == 0) return "0";  // no "-0"
+    return fmt::format("{:.6g}", v);
+}
+
+template <typename V>
+std::string vec3(const V& v) {
+    return fmt::format("({}, {}, {})", num(v.x), num(v.y), num(v.z));
+}
+
+std::string vec4(const Vec4f& v) { return fmt::format("({}, {}, {}, {})", num(v.x), num(v.y), num(v.z), num(v.w)); }
+
+const char* yes_no(bool b) { return b ? "yes" : "no"; }
+
+const char* light_type(LightType t) {
+    switch (t) {
+        case LightType::Point:
+            return "point";
+        case LightType::Spot:
+            return "spot";
+        default:
+            return "directional";
+    }
+}
+
+const char* attenuation_name(Attenuation a) {
+    switch (a) {
+        case Attenuation::InverseSquare:
+            return "inverse-square";
+        case Attenuation::Classic:
+            return "classic";
+        default:
+            return "none";
+    }
+}
+
+const char* alpha_name(AlphaMode m) {
+    switch (m) {
+        case AlphaMode::Mask:
+            return "mask";
+        case AlphaMode::Blend:
+            return "blend";
+        default:
+            return "opaque";
+    }
+}
+
+const char* wrap_name(WrapMode w) {
+    switch (w) {
+        case WrapMode::ClampToEdge:
+            return "clamp";
+        case WrapMode::MirroredRepeat:
+            return "mirror";
+        default:
+            return "repeat";
+    }
+}
+
+const char* support_name(ExtensionSupport s) {
+    switch (s) {
+        case ExtensionSupport::Supported:
+            return "supported";
+        case ExtensionSupport::Ignored:
+            return "ignored";
+        default:
+            return "refused";
+    }
+}
+
+/// " slot=tex3(uv1, scale 0.5, transform ...)" or "" when the slot is empty.
+std::string texture_slot(const char* slot, const TextureRef& ref, bool show_scale) {
+    if (!ref.valid()) return "";
+    std::string s = fmt::format(" {}=tex{}(uv{}", slot, ref.texture, ref.uv_set);
+    if (show_scale) s += fmt::format(", scale {}", num(ref.scale));
+    if (!ref.transform.identity())
+        s += fmt::format(", offset ({}, {}) rotation {} scale ({}, {})", num(ref.transform.offset.x),
+                         num(ref.transform.offset.y), num(ref.transform.rotation), num(ref.transform.scale.x),
+                         num(ref.transform.scale.y));
+    return s + ")";
+}
+
+}  // namespace
+
+std::string describe_scene(const Scene& scene) {
+    std::string out;
+    auto line = [&](const std::string& s) {
+        out += s;
+        out += '\n';
+    };
+    line(fmt::format("file: {}", scene.source));
+    line(
+        fmt::format("counts: meshes={} triangles={} instanced_triangles={} instances={} spheres={} materials={} "
+                    "textures={} lights={} cameras={} warnings={}",
+                    scene.meshes.size(), scene.mesh_triangle_count(), scene.instanced_triangle_count(),
+                    scene.instances.size(), scene.spheres.size(), scene.materials.size(), scene.textures.size(),
+                    scene.lights.size(), scene.cameras.size(), scene.warnings.size()));
+    const Bounds3d b = scene.world_bounds();
+    if (b.empty())
+        line("bounds: empty");
+    else
+        line(fmt::format("bounds: min={} max={} center={} diagonal={}", vec3(b.lo), vec3(b.hi), vec3(b.center()),
+                         num(length(b.diagonal()))));
+
+    for (size_t i = 0; i < scene.lights.size(); ++i) {
+        const Light& l = scene.lights[i];
+        std::string s =
+            fmt::format("light[{}]: name=\"{}\" type={} color={} intensity={} range={}", i, l.name, light_type(l.type),
+                        vec3(l.color), num(l.intensity), l.range > 0 ? num(l.range) : std::string("inf"));
+        if (l.type == LightType::Spot)
+            s += fmt::format(" inner_cone={} outer_cone={}", num(l.inner_cone), num(l.outer_cone));
+        if (l.type != LightType::Directional) s += fmt::format(" position={}", vec3(l.position));
+        if (l.type != LightType::Point) s += fmt::format(" direction={}", vec3(l.direction));
+        s += fmt::format(" attenuation={} default={}", attenuation_name(l.attenuation), yes_no(l.is_default));
+        line(s);
+    }
+
+    for (size_t i = 0; i < scene.cameras.size(); ++i) {
+        const Camera& c = scene.cameras[i];
+        const Vec3d pos = c.world_from_camera.apply_point(Vec3d(0.0));
+        const Vec3d fwd = normalize(c.world_from_camera.apply_vector({0, 0, -1}));
+        std::string s = fmt::format("camera[{}]: name=\"{}\" ", i, c.name);
+        if (c.type == CameraType::Perspective)
+            s += fmt::format("type=perspective yfov={} yfov_deg={}", num(c.yfov), num(c.yfov * 180 / std::numbers::pi));
+        else
+            s += fmt::format("type=orthographic xmag={} ymag={}", num(c.xmag), num(c.ymag));
+        s += fmt::format(" aspect={} znear={} zfar={} position={} forward={} default={}",
+                         c.aspect > 0 ? num(c.aspect) : std::string("unset"), num(c.znear),
+                         c.zfar > 0 ? num(c.zfar) : std::string("inf"), vec3(pos), vec3(fwd), yes_no(c.is_default));
+        line(s);
+    }
+
+    const MappingOptions mapping{};
+    for (size_t i = 0; i < scene.materials.size(); ++i) {
+        const Material& m = scene.materials[i];
+        if (m.model == MaterialModel::GltfPbr) {
+            line(fmt::format(
+                "material[{}]: name=\"{}\" model=gltf base_color={} metallic={} roughness={} "
+                "emissive={} emissive_strength={} transmission={} ior={} volume={} thickness={} "
+                "attenuation_color={} attenuation_distance={} specular={} specular_color={} unlit={} "
+                "alpha={} alpha_cutoff={} double_sided={}",
+                i, m.name, vec4(m.base_color), num(m.metallic), num(m.roughness), vec3(m.emissive),
+                num(m.emissive_strength), num(m.transmission), num(m.ior), yes_no(m.has_volume), num(m.thickness),
+                vec3(m.attenuation_color), num(m.attenuation_distance), num(m.specular), vec3(m.specular_color),
+                yes_no(m.unlit), alpha_name(m.alpha_mode), num(m.alpha_cutoff), yes_no(m.double_sided)));
+        } else {
+            line(fmt::format("material[{}]: name=\"{}\" model=classic double_sided={}", i, m.name,
+                             yes_no(m.double_sided)));
+        }
+        const WhittedCoeffs c = map_material_constant(m, mapping);
+        line(
+            fmt::format("material[{}] whitted: kd={} ka={} ks={} n={} kr={} kt={} ior={} thin={} emission={} "
+                        "absorption={}",
+                        i, vec3(c.kd), vec3(c.ka), vec3(c.ks), num(c.n), vec3(c.kr), vec3(c.kt), num(c.ior),
+                        yes_no(c.thin), vec3(c.emission), vec3(c.absorption)));
+        const std::string tex = texture_slot("base_color", m.base_color_texture, false) +
+                                texture_slot("metallic_roughness", m.metallic_roughness_texture, false) +
+                                texture_slot("normal", m.normal_texture, true) +
+                                texture_slot("occlusion", m.occlusion_texture, true) +
+                                texture_slot("emissive", m.emissive_texture, false) +
+                                texture_slot("transmission", m.transmission_texture, false) +
+                                texture_slot("specular", m.specular_texture, false) +
+                                texture_slot("specular_color", m.specular_color_texture, false);
+        line(fmt::format("material[{}] textures:{}", i, tex.empty() ? " none" : tex));
+    }
+
+    for (size_t i = 0; i < scene.textures.size(); ++i) {
+        const Texture& t = scene.textures[i];
+        const std::string size =
+            t.levels.empty() ? std::string("not-loaded") : fmt::format("{}x{}", t.levels[0].width, t.levels[0].height);
+        line(fmt::format("texture[{}]: name=\"{}\" size={} levels={} srgb={} wrap={}/{} filter={}/{} mips={} image={}",
+                         i, t.name, size, t.levels.size(), yes_no(t.srgb), wrap_name(t.wrap_s), wrap_name(t.wrap_t),
+                         t.mag_filter == FilterMode::Nearest ? "nearest" : "linear",
+                         t.min_filter == FilterMode::Nearest ? "nearest" : "linear", yes_no(t.use_mips), t.image));
+    }
+
+    for (const ExtensionUse& e : scene.extensions)
+        line(fmt::format("extension: {} {} required={} note=\"{}\"", e.name, support_name(e.support),
+                         yes_no(e.required), e.note));
+    for (const std::string& w : scene.warnings) line("warning: " + w);
+    return out;
+}
+
+}  // namespace whitted

@@ -1,0 +1,79 @@
+// `whitted info` text (describe_scene): stable, one greppable record per line.
+
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "importers/scene_report.h"
+#include "test_importer_util.h"
+
+namespace whitted::test {
+namespace {
+
+std::vector<std::string> lines_starting_with(const std::string& text, const std::string& prefix) {
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);)
+        if (line.rfind(prefix, 0) == 0) out.push_back(line);
+    return out;
+}
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+TEST(SceneReport, CountsCamerasMaterialsAndWarnings) {
+    const Scene s = load_scene(asset("Cameras/glTF/Cameras.gltf"));
+    const std::string text = describe_scene(s);
+    EXPECT_EQ(text, describe_scene(s));  // stable
+    const auto counts = lines_starting_with(text, "counts: ");
+    ASSERT_EQ(counts.size(), 1u);
+    EXPECT_TRUE(contains(counts[0],
+                         "meshes=1 triangles=2 instanced_triangles=2 instances=1 spheres=0 materials=1 "
+                         "textures=0 lights=1 cameras=2"))
+        << counts[0];
+    const auto cams = lines_starting_with(text, "camera[");
+    ASSERT_EQ(cams.size(), 2u);
+    EXPECT_TRUE(contains(cams[0], "type=perspective yfov=0.7 "));
+    EXPECT_TRUE(contains(cams[0], "aspect=1 znear=0.01 zfar=100 position=(0.5, 0.5, 3) forward=(0, 0, -1) default=no"))
+        << cams[0];
+    EXPECT_TRUE(contains(cams[1], "type=orthographic xmag=1 ymag=1"));
+    // The default light, its warning, and the default material with its mapped coefficients.
+    const auto lights = lines_starting_with(text, "light[0]: ");
+    ASSERT_EQ(lights.size(), 1u);
+    EXPECT_TRUE(contains(lights[0], "type=directional")) << lights[0];
+    EXPECT_TRUE(contains(lights[0], "intensity=1 "));
+    EXPECT_TRUE(contains(lights[0], "default=yes"));
+    EXPECT_EQ(lines_starting_with(text, "warning: no lights in the file").size(), 1u);
+    EXPECT_EQ(lines_starting_with(text, "material[0]: name=\"default\"").size(), 1u);
+    EXPECT_EQ(lines_starting_with(text, "material[0] whitted: kd=").size(), 1u);
+    EXPECT_EQ(lines_starting_with(text, "material[0] textures: none").size(), 1u);
+    EXPECT_EQ(text.back(), '\n');
+}
+
+TEST(SceneReport, LightsTexturesAndExtensions) {
+    const Scene s = load_scene(asset("LightsPunctualLamp/glTF/LightsPunctualLamp.gltf"), no_textures());
+    const std::string text = describe_scene(s);
+    const auto lights = lines_starting_with(text, "light[");
+    ASSERT_EQ(lights.size(), 5u);
+    EXPECT_TRUE(contains(lights[0], "name=\"Point\" type=point color=(1, 0.631875, 0.2391) intensity=15 range=inf"))
+        << lights[0];
+    EXPECT_TRUE(contains(lights[0], "attenuation=inverse-square default=no"));
+    EXPECT_EQ(lines_starting_with(text, "texture[").size(), 7u);
+    EXPECT_TRUE(contains(text, "texture[0]: name=\"material0_basecolor.jpeg\" size=not-loaded levels=0 srgb=yes"));
+    EXPECT_TRUE(contains(text, "extension: KHR_lights_punctual supported required=no"));
+    EXPECT_TRUE(contains(text, "extension: KHR_materials_transmission supported required=no"));
+    EXPECT_TRUE(contains(text,
+                         "material[2] textures: base_color=tex0(uv0) metallic_roughness=tex1(uv0) "
+                         "normal=tex2(uv0, scale 1) emissive=tex3(uv0) transmission=tex6(uv0)"));
+    EXPECT_EQ(lines_starting_with(text, "warning: no cameras in the scene").size(), 1u);
+}
+
+TEST(SceneReport, TextureTransformIsShown) {
+    const Scene s = load_scene(asset("TextureTransformTest/glTF/TextureTransformTest.gltf"), no_textures());
+    const std::string text = describe_scene(s);
+    EXPECT_TRUE(contains(text, "base_color=tex1(uv0, offset (-0.2, -0.1) rotation 0.3 scale (1.5, 1.5))")) << text;
+}
+
+}  // namespace
+}  // namespace whitted::test
