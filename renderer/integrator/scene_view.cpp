@@ -96,6 +96,21 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit) const {
     const Vec3f p1 = xf_point(xf.m, mesh.positions[i1]);
     const Vec3f p2 = xf_point(xf.m, mesh.positions[i2]);
     sp.p = p0 * w + p1 * u + p2 * v;
+    sp.p_shadow = sp.p;
+    if (!mesh.normals.empty()) {
+        // Shadow terminator (Hanika, "Hacking the Shadow Terminator", Ray Tracing Gems II, 2021):
+        // with smooth normals on a coarse mesh, points near the terminator see the light by N.L but
+        // the flat triangle is shadowed by its neighbours, giving blocky shadows. Lift the shadow
+        // origin onto the tangent planes of the vertex normals, blended barycentrically. Done in
+        // object space, where the planes are exact, then transformed (affine maps keep planes).
+        const Vec3f& a = mesh.positions[i0];
+        const Vec3f& b = mesh.positions[i1];
+        const Vec3f& c = mesh.positions[i2];
+        const Vec3f po = a * w + b * u + c * v;
+        auto lift = [&](const Vec3f& pv, const Vec3f& nv) { return nv * std::min(0.f, dot(po - pv, nv)); };
+        const Vec3f delta = lift(a, mesh.normals[i0]) * w + lift(b, mesh.normals[i1]) * u + lift(c, mesh.normals[i2]) * v;
+        if (delta != Vec3f(0.f) && is_finite(delta)) sp.p_shadow = xf_point(xf.m, po - delta);
+    }
     Vec3f ng = normalize(cross(p1 - p0, p2 - p0));
     if (ng == Vec3f(0.f)) ng = normalize(-ray.dir);  // degenerate triangle: face the ray
     sp.ng = ng;

@@ -14,6 +14,8 @@ namespace whitted {
 /// Everything the integrator needs about one hit point (world space).
 struct SurfacePoint {
     Vec3f p;                    ///< position, interpolated from the triangle's world-space vertices
+    Vec3f p_shadow;             ///< shadow-ray origin on the front side: p lifted onto the smooth
+                                ///< surface the vertex normals describe (Hanika 2021), = p when flat
     Vec3f ng;                   ///< unit geometric normal (front side by winding)
     Vec3f ns;                   ///< unit shading normal (interpolated, normal-mapped), front side
     Vec2f uv[2];                ///< TEXCOORD_0/1 (0 when absent)

@@ -65,15 +65,16 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
     if (!unlit) {
         // Local model: I = Ia Ka + sum_i Is_i fat_i s_i (kd (N.L) + ks (N.H)^n).
         result += m_settings.ambient * c.ka;
-        const Vec3f shadow_org = offset_ray_origin(sp.p, Ng);
+        const Vec3f shadow_org = offset_ray_origin(front ? sp.p_shadow : sp.p, Ng);
         const bool diffuse_or_specular = !is_black(c.kd) || !is_black(c.ks);
         for (const Light& light : scene.lights) {
             if (!diffuse_or_specular) break;
             LightSample ls = sample_light(light, sp.p);
             if (is_black(ls.intensity)) continue;
             const float n_dot_l = dot(N, ls.L);
-            // The seed's `lum`: light only from the lit side (shading and geometric normal agree).
-            if (n_dot_l <= 0.f || dot(Ng, ls.L) <= 0.f) continue;
+            // The seed's `lum`: light only when N.L > 0 (shading normal). A light below the flat
+            // facet but above the smooth surface still counts; the shadow ray decides.
+            if (n_dot_l <= 0.f) continue;
             Ray shadow;
             shadow.org = shadow_org;
             if (light.type == LightType::Directional) {
