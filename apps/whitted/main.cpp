@@ -13,6 +13,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "apps/whitted/command.h"
 #include "importers/scene_loader.h"
 #include "importers/scene_report.h"
 #include "renderer/core/error.h"
@@ -223,9 +224,17 @@ int main(int argc, char** argv) {
     info->add_option("--scene", info_scene, "glTF scene index (-1 = the file's default scene)")->capture_default_str();
     info->add_flag("--no-textures", info_no_textures, "Skip decoding images");
 
+    // whitted bench <name>: benchmarks print figures and write CSV/plots (docs/performance.md).
+    CLI::App* bench = app.add_subcommand("bench", "Benchmarks: print figures, write CSV and plots");
+    bench->require_subcommand(1);
+    std::vector<app::Command> commands;
+    // Each benchmark module registers itself here (one line each):
+
     // Global options (--log-level) may also follow the subcommand.
     render->fallthrough();
     info->fallthrough();
+    bench->fallthrough();
+    for (app::Command& c : commands) c.app->fallthrough();
 
     try {
         app.parse(argc, argv);
@@ -244,6 +253,8 @@ int main(int argc, char** argv) {
         set_log_level(parse_log_level(log_level));
         if (render->parsed()) return run_render(ro, command_line(argc, argv));
         if (info->parsed()) return run_info(info_input, info_scene, !info_no_textures);
+        for (app::Command& c : commands)
+            if (c.app->parsed()) return c.run();
     } catch (const Error& e) {
         std::fprintf(stderr, "whitted: error: %s\n", e.what());
         return 1;
