@@ -9,6 +9,7 @@
 // Every failure is a whitted::Error naming the file and, where one applies, a JSON pointer.
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -17,6 +18,8 @@
 #include <map>
 #include <numbers>
 #include <numeric>
+#include <optional>
+#include <span>
 #include <string_view>
 #include <tuple>
 #include <unordered_map>
@@ -29,6 +32,7 @@
 #include "importers/gltf_extensions.h"
 #include "importers/gltf_json.h"
 #include "importers/gltf_validation.h"
+#include "importers/image_decode.h"
 #include "importers/scene_loader.h"
 #include "importers/warning_log.h"
 #include "importers/located_error.h"
@@ -43,6 +47,7 @@ namespace {
 using namespace gltf;
 
 // Documented in docs/lights.md and docs/gltf-support.md.
+constexpr size_t kMaxJsonDepth = 64;                                     ///< array/object nesting (docs/fuzzing.md)
 constexpr double kDefaultCameraYfov = 0.8;                               ///< radians (about 45.8 degrees)
 constexpr double kDefaultCameraMargin = 1.1;                             ///< bounding sphere fills 1/1.1 of the view
 constexpr float kDefaultLightIntensity = 1.f;                            ///< lux (renderer units, docs/lights.md)
@@ -51,7 +56,7 @@ const Vec3d kDefaultLightDirection = normalize(Vec3d(0.4, -1.0, -0.6));  ///< tr
 // ---------------------------------------------------------------------------------------------
 // Reading the file
 
-std::vector<uint8_t> read_file(const std::string& path) {
+std::vector<uint8_t> read_file(const std::string& path, size_t max_memory) {
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) throw Error(file_loc(path), "is a directory, not a glTF file");
     std::ifstream in(path, std::ios::binary);
@@ -62,6 +67,9 @@ std::vector<uint8_t> read_file(const std::string& path) {
     if (size < 0) throw Error(file_loc(path), "cannot determine the file size");
     // tinygltf takes 32-bit lengths.
     if (uint64_t(size) >= (uint64_t(1) << 32)) throw Error(file_loc(path), "file is 4 GiB or larger: not supported");
+    if (uint64_t(size) > max_memory)
+        throw Error(file_loc(path),
+                    fmt::format("file of {} bytes exceeds the memory limit of {} bytes", size, max_memory));
     std::vector<uint8_t> bytes(static_cast<size_t>(size));
     if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size)) throw Error(file_loc(path), "read error");
     return bytes;
@@ -75,7 +83,7 @@ uint32_t load_u32(const uint8_t* p) {
 
 /// GLB container checks (glTF 2.0 spec 4.4) with messages that say what is wrong; tinygltf's
 /// own checks only say "Invalid glTF binary".
-void check_glb_container(const std::string& path, const std::vector<uint8_t>& b, Scene& scene) {
+void check_glb_container(const std::string& path, std::span<const uint8_t> b, Scene& scene) {
     if (b.size() < 12)
         throw Error(file_loc(path), fmt::format("truncated GLB: {} bytes, the header needs 12", b.size()));
     if (std::memcmp(b.data(), "glTF", 4) != 0)
@@ -119,9 +127,13 @@ struct ImageCapture {
 struct LoaderState {
     std::vector<ImageCapture> images;
     bool keep_bytes = true;  ///< false with ImportOptions::load_textures == false
+    size_t max_memory = 0;   ///< ImportOptions::max_memory, for the image header check
+    std::string refused;     ///< "/images/<i>: <reason>" of the first image refused by its header
 };
 
-bool capture_image(tinygltf::Image* image, const int index, std::string*, std::string*, int, int,
+/// tinygltf's image-loader hook: keeps the encoded bytes of uri / data-URI images after checking
+/// the dimensions their header declares (so a small file cannot claim a 100000 x 100000 image).
+bool capture_image(tinygltf::Image* image, const int index, std::string* err, std::string*, int, int,
                    const unsigned char* bytes, int size, void* user) {
     auto* state = static_cast<LoaderState*>(user);
     if (index < 0) return false;
@@ -129,17 +141,138 @@ bool capture_image(tinygltf::Image* image, const int index, std::string*, std::s
     ImageCapture& c = state->images[size_t(index)];
     c.seen = true;
     if (image->bufferView >= 0) {
-        c.from_buffer_view = true;  // `bytes` may point outside the buffer: do not touch
+        c.from_buffer_view = true;  // `bytes` may point outside the buffer: do not touch (checked at decode)
         return true;
     }
-    if (state->keep_bytes && bytes != nullptr && size > 0) c.encoded.assign(bytes, bytes + size);
+    if (!state->keep_bytes || bytes == nullptr || size <= 0) return true;
+    // Formats the header parser does not know fail later, at decoding, with their own message.
+    int w = 0, h = 0;
+    if (image_size_from_header(bytes, size_t(size), w, h)) {
+        if (const std::string why = check_image_size(w, h, state->max_memory); !why.empty()) {
+            if (state->refused.empty()) state->refused = fmt::format("/images/{}: {}", index, why);
+            if (err != nullptr) *err += why + "\n";
+            return false;
+        }
+    }
+    c.encoded.assign(bytes, bytes + size);
     return true;
 }
 
-/// Resources resolve next to the glTF file only: tinygltf also tries "./<uri>" (the working
-/// directory), which this refuses by accepting absolute paths only.
-bool file_exists_absolute(const std::string& path, void*) {
-    return !path.empty() && path[0] == '/' && tinygltf::FileExists(path, nullptr);
+/// Where tinygltf may read external resources (buffers and images), enforced in its file-system
+/// callbacks since it reads them while parsing: relative URIs resolve against the glTF file's
+/// folder (never the working directory); leaving that folder ("../") needs
+/// ImportOptions::allow_outside_uris; absolute paths and URIs with a scheme (file://, http://)
+/// are always refused. The first refusal becomes the import error.
+struct UriPolicy {
+    std::string base;            ///< absolute, normalized folder of the glTF file (tinygltf's base_dir)
+    bool allow_outside = false;  ///< ImportOptions::allow_outside_uris
+    size_t max_bytes = 0;        ///< largest resource read (ImportOptions::max_memory)
+    std::string refused;         ///< first refusal, one line
+};
+
+/// The file a tinygltf lookup ("<base>/<uri>") may read under the policy; nullopt when refused
+/// (the reason is recorded) or when tinygltf tries its working-directory fallback ("./<uri>").
+std::optional<std::filesystem::path> resolve_uri(const std::string& lookup, UriPolicy& policy) {
+    namespace fs = std::filesystem;
+    const std::string prefix = !policy.base.empty() && policy.base.back() == '/' ? policy.base : policy.base + "/";
+    if (lookup.compare(0, prefix.size(), prefix) != 0) return std::nullopt;
+    const std::string uri = lookup.substr(prefix.size());
+    auto refuse = [&](const std::string& why) -> std::optional<fs::path> {
+        std::string shown = uri;  // control bytes (a decoded %00) must not reach the terminal
+        for (char& c : shown)
+            if ((unsigned char)c < 0x20 || c == 0x7f) c = '?';
+        if (policy.refused.empty()) policy.refused = fmt::format("external URI '{}' refused: {}", shown, why);
+        return std::nullopt;
+    };
+    // A scheme ("file:", "http:"): RFC 3986 3.1, ALPHA *( ALPHA / DIGIT / "+" / "-" / "." ) ":".
+    size_t k = 0;
+    while (k < uri.size() && (std::isalnum((unsigned char)uri[k]) || uri[k] == '+' || uri[k] == '-' || uri[k] == '.'))
+        ++k;
+    const bool has_scheme = k > 0 && k < uri.size() && uri[k] == ':' && std::isalpha((unsigned char)uri[0]);
+    // Empty URIs and data: URIs tinygltf could not decode end in its own, clearer errors.
+    if (uri.empty() || (has_scheme && uri.compare(0, 5, "data:") == 0)) return std::nullopt;
+    if (has_scheme)
+        return refuse(fmt::format("'{}' URIs are not read (only paths relative to the glTF file and data: URIs)",
+                                  uri.substr(0, k + 1)));
+    // tinygltf has already percent-decoded the URI ("%2e%2e/" arrives as "../"; "%00" as a NUL).
+    const std::string& rel = uri;
+    if (rel.find('\0') != std::string::npos) return refuse("it contains a NUL byte");
+    if (rel[0] == '/') return refuse("absolute paths are not read (use a path relative to the glTF file)");
+    const fs::path base(policy.base);
+    const fs::path target = (base / rel).lexically_normal();
+    const fs::path inside = target.lexically_relative(base);
+    const bool outside = inside.empty() || *inside.begin() == "..";
+    if (outside && !policy.allow_outside)
+        return refuse("it leaves the folder of the glTF file (allow with --allow-outside-uris)");
+    return target;
+}
+
+/// FsCallbacks::FileExists under the policy: regular files only (no devices, FIFOs, folders).
+bool policy_file_exists(const std::string& lookup, void* user) {
+    auto& policy = *static_cast<UriPolicy*>(user);
+    const std::optional<std::filesystem::path> file = resolve_uri(lookup, policy);
+    if (!file) return false;
+    std::error_code ec;
+    const std::filesystem::file_status st = std::filesystem::status(*file, ec);
+    if (ec || !std::filesystem::exists(st)) return false;
+    if (!std::filesystem::is_regular_file(st)) {
+        if (policy.refused.empty())
+            policy.refused = fmt::format("external URI '{}' is not a regular file", file->string());
+        return false;
+    }
+    return true;
+}
+
+/// FsCallbacks::ReadWholeFile under the policy, refusing files larger than the memory limit.
+bool policy_read_file(std::vector<unsigned char>* out, std::string* err, const std::string& lookup, void* user) {
+    auto& policy = *static_cast<UriPolicy*>(user);
+    const std::optional<std::filesystem::path> file = resolve_uri(lookup, policy);
+    if (!file) {
+        if (err) *err += "refused by the URI policy";
+        return false;
+    }
+    std::error_code ec;
+    const uintmax_t size = std::filesystem::file_size(*file, ec);
+    if (ec || size > policy.max_bytes) {
+        if (!ec && policy.refused.empty())
+            policy.refused = fmt::format("external file '{}' of {} bytes exceeds the memory limit of {} bytes",
+                                         file->string(), size, policy.max_bytes);
+        if (err) *err += ec ? ec.message() : "over the memory limit";
+        return false;
+    }
+    std::ifstream in(*file, std::ios::binary);
+    out->resize(size_t(size));
+    if (!in || (size > 0 && !in.read(reinterpret_cast<char*>(out->data()), std::streamsize(size)))) {
+        if (err) *err += "read error";
+        return false;
+    }
+    return true;
+}
+
+bool refuse_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+    if (err) *err += "whitted never writes through tinygltf";
+    return false;
+}
+
+/// Deepest nesting of JSON arrays/objects, scanning at most until `limit` is passed: tinygltf
+/// converts extras and extensions recursively, so a file of 100000 '[' would overflow the stack.
+size_t json_depth(const char* p, size_t n, size_t limit) {
+    size_t depth = 0, deepest = 0;
+    bool in_string = false;
+    for (size_t i = 0; i < n && deepest <= limit; ++i) {
+        const char c = p[i];
+        if (in_string) {
+            if (c == '\\') ++i;  // skip the escaped character
+            else if (c == '"') in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            deepest = std::max(deepest, ++depth);
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
+    }
+    return deepest;
 }
 
 /// Shortens the payload of every data URI in a message ("data:...;base64,AAAA... (123456 chars)"):
@@ -204,40 +337,6 @@ std::string node_label(const tinygltf::Model& model, int node) {
     return n.empty() ? fmt::format("node {}", node) : n;
 }
 
-/// PNG and JPEG dimensions from the header, to estimate decoded size before decoding.
-bool image_size_from_header(const uint8_t* p, size_t n, int& w, int& h) {
-    auto be16 = [&](size_t i) { return (uint32_t(p[i]) << 8) | p[i + 1]; };
-    auto be32 = [&](size_t i) { return (be16(i) << 16) | be16(i + 2); };
-    if (n >= 24 && std::memcmp(p, "\x89PNG\r\n\x1a\n", 8) == 0 && std::memcmp(p + 12, "IHDR", 4) == 0) {
-        w = int(std::min<uint32_t>(be32(16), 1u << 30));
-        h = int(std::min<uint32_t>(be32(20), 1u << 30));
-        return true;
-    }
-    if (n >= 4 && p[0] == 0xFF && p[1] == 0xD8) {
-        size_t i = 2;
-        while (i + 9 < n) {
-            if (p[i] != 0xFF) return false;
-            const uint8_t marker = p[i + 1];
-            if (marker == 0xFF) {  // fill byte
-                ++i;
-                continue;
-            }
-            if (marker == 0xD8 || marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {
-                i += 2;
-                continue;
-            }
-            const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
-            if (sof) {
-                h = int(be16(i + 5));
-                w = int(be16(i + 7));
-                return true;
-            }
-            i += 2 + be16(i + 2);
-        }
-    }
-    return false;
-}
-
 // ---------------------------------------------------------------------------------------------
 // The importer
 
@@ -254,9 +353,10 @@ class GltfImporter {
 public:
     GltfImporter(const std::string& path, const ImportOptions& options) : m_path(path), m_options(options) {}
 
-    Scene run() {
+    /// Imports the glTF (JSON or GLB) held in `bytes`.
+    Scene run(std::span<const uint8_t> bytes) {
         m_scene.source = m_path;
-        load_model();
+        load_model(bytes);
         validate_gltf(m_model, m_path, m_options.max_memory, m_scene);
         check_images_present();
         classify_extensions();
@@ -277,8 +377,7 @@ private:
     }
 
     // ---- parsing ------------------------------------------------------------------------------
-    void load_model() {
-        std::vector<uint8_t> bytes = read_file(m_path);
+    void load_model(std::span<const uint8_t> bytes) {
         if (bytes.empty()) fail("", "empty file (0 bytes)");
         if (bytes.size() > m_options.max_memory)
             fail("", "file of {} bytes exceeds the memory limit of {} bytes", bytes.size(), m_options.max_memory);
@@ -295,15 +394,25 @@ private:
             // glTF 2.0 spec 3.2: "JSON must use UTF-8 encoding without BOM" (validator: INVALID_JSON).
             fail("", "invalid JSON: the file starts with a UTF-8 byte order mark, which glTF forbids");
         }
+        // JSON nesting: the whole file, or the GLB JSON chunk (its length was checked above).
+        const size_t json_offset = binary ? 20 : 0;
+        const size_t json_size = binary ? size_t(load_u32(bytes.data() + 12)) : bytes.size();
+        if (json_depth(reinterpret_cast<const char*>(bytes.data()) + json_offset, json_size, kMaxJsonDepth) >
+            kMaxJsonDepth)
+            fail("", "invalid JSON: arrays/objects nested deeper than {} levels", kMaxJsonDepth);
 
         m_loader.keep_bytes = m_options.load_textures;
-        tinygltf::TinyGLTF parser;
-        parser.SetImageLoader(&capture_image, &m_loader);
-        parser.SetFsCallbacks({&file_exists_absolute, &tinygltf::ExpandFilePath, &tinygltf::ReadWholeFile,
-                               &tinygltf::WriteWholeFile, nullptr});
+        m_loader.max_memory = m_options.max_memory;
         std::error_code ec;
         std::filesystem::path abs = std::filesystem::absolute(m_path, ec);
         m_base_dir = (ec ? std::filesystem::path(m_path) : abs).lexically_normal().parent_path().string();
+        m_uri_policy.base = m_base_dir;
+        m_uri_policy.allow_outside = m_options.allow_outside_uris;
+        m_uri_policy.max_bytes = m_options.max_memory;
+        tinygltf::TinyGLTF parser;
+        parser.SetImageLoader(&capture_image, &m_loader);
+        parser.SetFsCallbacks(
+            {&policy_file_exists, &tinygltf::ExpandFilePath, &policy_read_file, &refuse_write, &m_uri_policy});
 
         std::string err, warn;
         bool ok = false;
@@ -318,6 +427,12 @@ private:
             fail("", "out of memory while parsing");
         } catch (const std::exception& e) {
             fail("", "glTF parse error: {}", one_line(e.what()));
+        }
+        // Refusals by the URI policy or the image header check explain a failure better than tinygltf.
+        if (!m_uri_policy.refused.empty()) fail("", "{}", m_uri_policy.refused);
+        if (!m_loader.refused.empty()) {
+            const size_t colon = m_loader.refused.find(':');
+            fail(m_loader.refused.substr(0, colon), "image refused: {}", m_loader.refused.substr(colon + 2));
         }
         if (!ok || !err.empty()) {
             const std::string msg = one_line(err.empty() ? "tinygltf failed without a message" : err);
@@ -614,6 +729,18 @@ private:
         return it->second;
     }
 
+    /// Instances multiply (nodes x primitives x EXT_mesh_gpu_instancing counts): a tiny file could
+    /// ask for billions, so their memory is checked as they are placed, before allocating.
+    void check_instance_budget(int node, size_t more) const {
+        const size_t per_instance = sizeof(Instance) + 32;  // as check_memory() counts them
+        const size_t have = m_scene.instances.size();
+        const size_t allowed = m_options.max_memory / per_instance;
+        if (more > allowed || have + more > allowed)
+            fail(fmt::format("/nodes/{}", node),
+                 "the node graph places more than {} instances, more than the memory limit of {} MiB allows", allowed,
+                 m_options.max_memory >> 20);
+    }
+
     /// One Instance per renderable primitive of `mesh`, using the mirrored mesh copy when the
     /// transform has a negative determinant.
     void place_mesh(int node, const std::string& label, int mesh, const Mat4d& world) {
@@ -621,6 +748,7 @@ private:
         const bool mirrored = world.det3() < 0;
         for (size_t p = 0; p < prims.size(); ++p) {
             if (!renderable(prims[p])) continue;
+            check_instance_budget(node, 1);
             Instance inst;
             inst.mesh = mesh_for(mesh, int(p), mirrored);
             inst.world_from_object = world;
@@ -659,7 +787,9 @@ private:
             for_each_element(accessor_data(m_model, acc[2]), [&](size_t i, const float* v) {
                 s[i] = {v[0], v[1], v[2]};
             });
-        m_scene.instances.reserve(m_scene.instances.size() + count * m_model.meshes[size_t(mesh)].primitives.size());
+        const size_t prims = m_model.meshes[size_t(mesh)].primitives.size();
+        check_instance_budget(node, prims > 0 && count > SIZE_MAX / prims ? SIZE_MAX : count * prims);
+        m_scene.instances.reserve(m_scene.instances.size() + count * prims);
         for (size_t i = 0; i < count; ++i) {
             const auto& q = r[i];
             const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
@@ -793,8 +923,7 @@ private:
             if (!m_options.load_textures) break;
             int w = 0, h = 0;
             const std::pair<const uint8_t*, size_t> bytes = image_bytes(t.image);
-            if (image_size_from_header(bytes.first, bytes.second, w, h))
-                total += size_t(w) * size_t(h) * (4 * 4 / 3 + 8);
+            if (image_size_from_header(bytes.first, bytes.second, w, h)) total += decoded_image_bytes(w, h);
         }
         if (total > m_options.max_memory)
             fail("", "the scene needs about {} MiB, more than the limit of {} MiB (ImportOptions::max_memory)",
@@ -1018,42 +1147,16 @@ private:
         return {c.encoded.data(), c.encoded.size()};
     }
 
-    /// Decodes image `i` to 8-bit RGBA (stb_image through tinygltf; 16-bit images rounded to 8).
+    /// Decodes image `i` to 8-bit RGBA (stb_image through tinygltf; 16-bit images rounded to 8)
+    /// after checking the dimensions its header declares.
     MipLevel decode_image(int i) const {
         const std::pair<const uint8_t*, size_t> bytes = image_bytes(i);
         const tinygltf::Image& src = m_model.images[size_t(i)];
-        const std::string label = !src.uri.empty()    ? src.uri
+        const std::string label = !src.uri.empty()    ? shorten_data_uris(src.uri)
                                   : !src.name.empty() ? src.name
                                                       : fmt::format("image {}", i);
-        if (bytes.second == 0 || bytes.second > size_t(std::numeric_limits<int>::max()))
-            fail(fmt::format("/images/{}", i), "image '{}' has no data", label);
-        tinygltf::Image img;
-        img.name = src.name;
-        std::string err, warn;
-        bool ok = false;
-        try {
-            ok = tinygltf::LoadImageData(&img, i, &err, &warn, 0, 0, bytes.first, int(bytes.second), nullptr);
-        } catch (const std::exception& e) {
-            err = e.what();
-        }
-        if (!ok || img.width < 1 || img.height < 1 || img.component != 4)
-            fail(fmt::format("/images/{}", i), "cannot decode image '{}': {}", label,
-                 one_line(err.empty() ? "unknown format" : err));
-        MipLevel level;
-        level.width = img.width;
-        level.height = img.height;
-        const size_t texels = size_t(img.width) * size_t(img.height);
-        level.texels.resize(texels * 4);
-        if (img.bits == 16) {
-            for (size_t k = 0; k < texels * 4; ++k) {
-                uint16_t v;
-                std::memcpy(&v, img.image.data() + 2 * k, 2);
-                level.texels[k] = uint8_t((uint32_t(v) * 255u + 32767u) / 65535u);
-            }
-        } else {
-            std::memcpy(level.texels.data(), img.image.data(), texels * 4);
-        }
-        return level;
+        return decode_image_rgba8(bytes.first, bytes.second, m_options.max_memory,
+                                  file_loc(m_path, fmt::format("/images/{}", i)), label);
     }
 
     void decode_textures() {
@@ -1125,6 +1228,7 @@ private:
     const std::string m_path;
     const ImportOptions m_options;
     std::string m_base_dir;
+    UriPolicy m_uri_policy;
     tinygltf::Model m_model;
     LoaderState m_loader;
     Scene m_scene;
@@ -1137,6 +1241,13 @@ private:
 
 }  // namespace
 
-Scene import_gltf(const std::string& path, const ImportOptions& options) { return GltfImporter(path, options).run(); }
+Scene import_gltf(const std::string& path, const ImportOptions& options) {
+    const std::vector<uint8_t> bytes = read_file(path, options.max_memory);
+    return GltfImporter(path, options).run(bytes);
+}
+
+Scene import_gltf_memory(std::span<const uint8_t> bytes, const std::string& path, const ImportOptions& options) {
+    return GltfImporter(path, options).run(bytes);
+}
 
 }  // namespace whitted

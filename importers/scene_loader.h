@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <span>
 #include <string>
 
 #include "renderer/scene/scene.h"
@@ -15,6 +17,8 @@ struct ImportOptions {
     bool add_default_light = true;              ///< a scene without lights gets the documented default
     bool add_default_camera = true;             ///< a scene without cameras gets one framing its bounds
     bool load_textures = true;                  ///< false: skip image decoding (faster `info`)
+    bool allow_outside_uris = false;            ///< external URIs may leave the file's folder ("../");
+                                                ///< absolute and file:// URIs are refused either way
 };
 
 /// Loads a scene, dispatching on the extension (.gltf, .glb).
@@ -22,5 +26,9 @@ Scene load_scene(const std::string& path, const ImportOptions& options = {});
 
 /// glTF 2.0 (.gltf with external or data-URI resources, .glb).
 Scene import_gltf(const std::string& path, const ImportOptions& options = {});
+
+/// glTF 2.0 from bytes in memory (JSON, or GLB when `path` ends in .glb or the bytes start with
+/// the GLB magic). `path` names the source in errors; its folder anchors relative URIs.
+Scene import_gltf_memory(std::span<const uint8_t> bytes, const std::string& path, const ImportOptions& options = {});
 
 }  // namespace whitted

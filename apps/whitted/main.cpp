@@ -6,12 +6,16 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
+
+#include <unistd.h>
 
 #include "apps/whitted/command.h"
 #include "importers/scene_loader.h"
@@ -21,10 +25,51 @@
 #include "renderer/integrator/render.h"
 #include "renderer/output/image_output.h"
 
+// Benchmark modules (one declaration each).
+namespace whitted::app {
+Command register_bench_aa(CLI::App& bench);  ///< `whitted bench aa` (apps/whitted/bench_aa.cpp)
+Command register_bench_accel(CLI::App& bench);  ///< `whitted bench accel` (apps/whitted/bench_accel.cpp)
+}  // namespace whitted::app
+using whitted::app::register_bench_aa;
+using whitted::app::register_bench_accel;
+
+// Process-wide hooks defined next to what they act on.
+namespace whitted {
+void remove_partial_output() noexcept;       ///< renderer/output/image_output.cpp: signal-safe
+void set_embree_memory_limit(size_t bytes);  ///< renderer/accel/embree/embree_accel.cpp
+}  // namespace whitted
+
 namespace {
 
 using namespace whitted;
 using Clock = std::chrono::steady_clock;
+
+// SIGINT/SIGTERM during `render`: nothing is written before the image is complete, so the first
+// signal ends the process at once, except while the image is being written: that write (atomic,
+// through a temporary file) finishes and the run then exits with 128 + signal. A second SIGINT
+// exits at once in every case, removing the temporary file of an unfinished write.
+std::atomic<int> g_signal_count{0};
+std::atomic<int> g_last_signal{0};
+std::atomic<bool> g_writing{false};
+
+extern "C" void on_interrupt(int sig) {
+    g_last_signal.store(sig);
+    if (g_signal_count.fetch_add(1) == 0 && g_writing.load()) return;
+    remove_partial_output();
+    static const char message[] = "\nwhitted: interrupted: no image written\n";
+    const ssize_t ignored = ::write(STDERR_FILENO, message, sizeof(message) - 1);
+    (void)ignored;
+    ::_exit(128 + sig);
+}
+
+void install_interrupt_handlers() {
+    struct sigaction sa {};
+    sa.sa_handler = &on_interrupt;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESTART;
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+}
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
@@ -56,8 +101,11 @@ AovSet parse_aovs(const std::vector<std::string>& names) {
         else if (n == "albedo") a.albedo = true;
         else if (n == "primid" || n == "prim_id" || n == "primitive") a.prim_id = true;
         else if (n == "instid" || n == "inst_id" || n == "instance") a.inst_id = true;
-        else if (n == "all") a = AovSet{true, true, true, true, true};
-        else throw Error(fmt::format("--aov: unknown AOV '{}' (available: depth, normal, albedo, primid, instid, all)", n));
+        else if (n == "aa_samples" || n == "aasamples") a.aa_samples = true;
+        else if (n == "all") a = AovSet{true, true, true, true, true, true};
+        else
+            throw Error(fmt::format(
+                "--aov: unknown AOV '{}' (available: depth, normal, albedo, primid, instid, aa_samples, all)", n));
     }
     return a;
 }
@@ -73,16 +121,23 @@ struct RenderOptions {
     int width = 0, height = 0, camera = 0, scene = -1, max_depth = 5, tile_size = 32, threads = 0, bits = 0;
     std::string background = "0", ambient = "0.05", crop, accel = "embree", ocio_config, display, view = "Standard";
     std::vector<std::string> aovs;
+    std::string aa = "adaptive", filter = "box";
+    float aa_threshold = AaSettings{}.threshold;
+    int aa_depth = AaSettings{}.depth, spp = AaSettings{}.spp;
     float exposure = 0.f, mirror_cutoff = 0.3f;
     bool fresnel = false, refract_thin = false, robust = false, no_progress = false, exr_float = false;
     double max_memory_gb = 8.0;
+    bool allow_outside_uris = false;
 };
 
 int run_render(const RenderOptions& o, const std::string& cmdline) {
+    install_interrupt_handlers();
     const auto t_load = Clock::now();
     ImportOptions io;
     io.scene_index = o.scene;
     io.max_memory = size_t(o.max_memory_gb * double(size_t(1) << 30));
+    io.allow_outside_uris = o.allow_outside_uris;
+    set_embree_memory_limit(io.max_memory);
     Scene scene = load_scene(o.input, io);
     const double load_s = seconds_since(t_load);
     for (const std::string& w : scene.warnings) log_warning("{}: {}", o.input, w);
@@ -102,6 +157,11 @@ int run_render(const RenderOptions& o, const std::string& cmdline) {
     rs.threads = o.threads;
     if (!o.crop.empty()) rs.crop = parse_crop(o.crop);
     rs.aovs = parse_aovs(o.aovs);
+    rs.aa.mode = parse_aa_mode(o.aa);
+    rs.aa.threshold = o.aa_threshold;
+    rs.aa.depth = o.aa_depth;
+    rs.aa.spp = o.spp;
+    rs.aa.filter = parse_pixel_filter(o.filter);
     rs.accel = o.accel;
     rs.robust = o.robust;
     rs.progress = !o.no_progress;
@@ -125,34 +185,46 @@ int run_render(const RenderOptions& o, const std::string& cmdline) {
     const auto t_write = Clock::now();
     const uint64_t rays = stats.rays.total();
     const double mrays = stats.render_seconds > 0 ? double(rays) / stats.render_seconds * 1e-6 : 0.0;
+    const double subdivided = stats.pixels ? double(stats.pixels_subdivided) / double(stats.pixels) : 0.0;
     std::string summary = fmt::format(
         "time: load {:.3f}s, build {:.3f}s, render {:.3f}s | rays: {} camera, {} shadow, {} reflection, "
-        "{} refraction, {} total, {:.2f} Mrays/s on {} threads",
+        "{} refraction, {} aov probe, {} total, {:.2f} Mrays/s on {} threads | aa: {} ({:.3f} camera rays/pixel, "
+        "{:.1f}% pixels subdivided)",
         load_s, stats.build_seconds, stats.render_seconds, stats.rays.camera, stats.rays.shadow,
-        stats.rays.reflection, stats.rays.refraction, rays, mrays, stats.threads);
+        stats.rays.reflection, stats.rays.refraction, stats.rays.aov_probe, rays, mrays, stats.threads, o.aa,
+        stats.pixels ? double(stats.rays.camera) / double(stats.pixels) : 0.0, 100.0 * subdivided);
     os.metadata["whitted:commandLine"] = cmdline;
     os.metadata["whitted:version"] = WHITTED_VERSION;
     os.metadata["whitted:stats"] = summary;
     os.metadata["Software"] = std::string("whitted ") + WHITTED_VERSION;
+    g_writing.store(true);
     write_image(film, o.output, os);
+    g_writing.store(false);
+    if (g_signal_count.load() > 0) {
+        std::fprintf(stderr, "whitted: interrupted: wrote %s before exiting\n", o.output.c_str());
+        return 128 + g_last_signal.load();
+    }
     const double write_s = seconds_since(t_write);
 
     std::fprintf(stderr,
                  "whitted: wrote %s (%dx%d)\n"
                  "  time   load %.3fs  build %.3fs  render %.3fs  write %.3fs\n"
                  "  rays   camera %llu  shadow %llu  reflection %llu  refraction %llu  total %llu\n"
-                 "  speed  %.2f Mrays/s on %d threads\n",
+                 "  speed  %.2f Mrays/s on %d threads\n"
+                 "  aa     %s: %.3f camera rays/pixel, %.1f%% pixels subdivided\n",
                  o.output.c_str(), film.width(), film.height(), load_s, stats.build_seconds, stats.render_seconds,
                  write_s, (unsigned long long)stats.rays.camera, (unsigned long long)stats.rays.shadow,
                  (unsigned long long)stats.rays.reflection, (unsigned long long)stats.rays.refraction,
-                 (unsigned long long)rays, mrays, stats.threads);
+                 (unsigned long long)rays, mrays, stats.threads, o.aa.c_str(),
+                 stats.pixels ? double(stats.rays.camera) / double(stats.pixels) : 0.0, 100.0 * subdivided);
     return 0;
 }
 
-int run_info(const std::string& input, int scene_index, bool textures) {
+int run_info(const std::string& input, int scene_index, bool textures, bool allow_outside_uris) {
     ImportOptions io;
     io.scene_index = scene_index;
     io.load_textures = textures;
+    io.allow_outside_uris = allow_outside_uris;
     Scene scene = load_scene(input, io);
     std::fputs(describe_scene(scene).c_str(), stdout);
     return 0;
@@ -196,14 +268,28 @@ int main(int argc, char** argv) {
     render->add_option("--mirror-cutoff", ro.mirror_cutoff,
                        "Roughness at which mirror reflection has faded to 0 (see docs/materials.md)")
         ->check(CLI::Range(0.0f, 1.0f))->capture_default_str();
-    render->add_option("--aov", ro.aovs, "Extra EXR channels: depth, normal, albedo, primid, instid, all")
+    render->add_option("--aov", ro.aovs, "Extra EXR channels: depth, normal, albedo, primid, instid, aa_samples, all")
         ->delimiter(',');
+    render->add_option("--aa", ro.aa, "Anti-aliasing: center, corners, adaptive, stratified (docs/antialiasing.md)")
+        ->check(CLI::IsMember({"center", "corners", "adaptive", "stratified"}))->capture_default_str();
+    render->add_option("--aa-threshold", ro.aa_threshold,
+                       "adaptive: split a square when its corners differ by more than this in display-referred "
+                       "sRGB values (max channel difference); negative = always split")
+        ->capture_default_str();
+    render->add_option("--aa-depth", ro.aa_depth, "adaptive: maximum subdivision depth (sub-squares of 1/2^depth pixel)")
+        ->check(CLI::Range(0, 8))->capture_default_str();
+    render->add_option("--spp", ro.spp, "stratified: samples per pixel, a square number k*k")
+        ->check(CLI::Range(1, 4096))->capture_default_str();
+    render->add_option("--filter", ro.filter, "stratified: pixel filter, box or tent (radius 1 pixel)")
+        ->check(CLI::IsMember({"box", "tent"}))->capture_default_str();
     render->add_option("--crop", ro.crop, "Render only the region x0,y0,x1,y1 (pixels, x1/y1 exclusive)");
     render->add_option("--threads", ro.threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 1024))
         ->capture_default_str();
     render->add_option("--tile-size", ro.tile_size, "Tile size in pixels")->check(CLI::Range(1, 4096))
         ->capture_default_str();
-    render->add_option("--accel", ro.accel, "Acceleration structure: embree")->capture_default_str();
+    render->add_option("--accel", ro.accel,
+                       "Acceleration structure: embree, bvh, grid, octree, kdop, brute; options after a colon, "
+                       "e.g. bvh:precision=double,bv=sphere (docs/accelerators.md)")->capture_default_str();
     render->add_flag("--robust", ro.robust, "Embree robust mode (RTC_SCENE_FLAG_ROBUST)");
     render->add_option("--ocio-config", ro.ocio_config, "OpenColorIO config (default: $OCIO, else the bundled one)");
     render->add_option("--display", ro.display, "OCIO display (default: the config's default)");
@@ -214,21 +300,27 @@ int main(int argc, char** argv) {
     render->add_flag("--no-progress", ro.no_progress, "Do not draw the progress bar");
     render->add_option("--max-memory", ro.max_memory_gb, "Refuse scenes whose data would exceed this many GiB")
         ->check(CLI::PositiveNumber)->capture_default_str();
+    render->add_flag("--allow-outside-uris", ro.allow_outside_uris,
+                     "Let the file's external URIs leave its folder (../); absolute and file:// URIs stay refused");
 
     // whitted info
     std::string info_input;
     int info_scene = -1;
-    bool info_no_textures = false;
+    bool info_no_textures = false, info_allow_outside_uris = false;
     CLI::App* info = app.add_subcommand("info", "Print what a scene file contains after import");
     info->add_option("scene", info_input, "Scene file (.gltf or .glb)")->required();
     info->add_option("--scene", info_scene, "glTF scene index (-1 = the file's default scene)")->capture_default_str();
     info->add_flag("--no-textures", info_no_textures, "Skip decoding images");
+    info->add_flag("--allow-outside-uris", info_allow_outside_uris,
+                   "Let the file's external URIs leave its folder (../); absolute and file:// URIs stay refused");
 
     // whitted bench <name>: benchmarks print figures and write CSV/plots (docs/performance.md).
     CLI::App* bench = app.add_subcommand("bench", "Benchmarks: print figures, write CSV and plots");
     bench->require_subcommand(1);
     std::vector<app::Command> commands;
     // Each benchmark module registers itself here (one line each):
+    commands.push_back(register_bench_aa(*bench));
+    commands.push_back(register_bench_accel(*bench));
 
     // Global options (--log-level) may also follow the subcommand.
     render->fallthrough();
@@ -252,7 +344,7 @@ int main(int argc, char** argv) {
     try {
         set_log_level(parse_log_level(log_level));
         if (render->parsed()) return run_render(ro, command_line(argc, argv));
-        if (info->parsed()) return run_info(info_input, info_scene, !info_no_textures);
+        if (info->parsed()) return run_info(info_input, info_scene, !info_no_textures, info_allow_outside_uris);
         for (app::Command& c : commands)
             if (c.app->parsed()) return c.run();
     } catch (const Error& e) {

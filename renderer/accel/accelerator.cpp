@@ -1,14 +1,141 @@
 #include "renderer/accel/accelerator.h"
 
+#include <cstdlib>
+#include <sstream>
+#include <vector>
+
+#include "renderer/accel/bvh/bvh_accel.h"
 #include "renderer/accel/embree/embree_accel.h"
+#include "renderer/accel/grid/grid_accel.h"
+#include "renderer/accel/octree/octree_accel.h"
 #include "renderer/core/error.h"
 
 namespace whitted {
 
+namespace {
+
+/// "name:key=value,key=value" split into the name and its options, with strict value parsers
+/// that name the spec and the key in their error.
+class AccelSpec {
+public:
+    explicit AccelSpec(const std::string& spec) : m_spec(spec) {
+        const size_t colon = spec.find(':');
+        m_name = spec.substr(0, colon);
+        if (colon == std::string::npos) return;
+        std::stringstream in(spec.substr(colon + 1));
+        std::string item;
+        while (std::getline(in, item, ',')) {
+            const size_t eq = item.find('=');
+            if (item.empty() || eq == std::string::npos || eq == 0)
+                throw Error(fmt::format("accelerator '{}': option '{}' is not key=value", spec, item));
+            m_options.push_back({item.substr(0, eq), item.substr(eq + 1), false});
+        }
+    }
+    const std::string& name() const { return m_name; }
+
+    /// The value of `key`, or nullptr when not given.
+    const std::string* find(const std::string& key) {
+        for (Option& o : m_options)
+            if (o.key == key) {
+                o.used = true;
+                return &o.value;
+            }
+        return nullptr;
+    }
+    template <typename T>
+    void number(const std::string& key, T& out, double lo, double hi) {
+        const std::string* v = find(key);
+        if (!v) return;
+        char* end = nullptr;
+        const double d = std::strtod(v->c_str(), &end);
+        if (v->empty() || *end != '\0' || !(d >= lo && d <= hi))
+            throw Error(fmt::format("accelerator '{}': {}={} is not a number in [{}, {}]", m_spec, key, *v, lo, hi));
+        out = T(d);
+    }
+    void precision(Precision& out) {
+        const std::string* v = find("precision");
+        if (!v) return;
+        if (*v == "float") out = Precision::Float;
+        else if (*v == "double") out = Precision::Double;
+        else throw Error(fmt::format("accelerator '{}': precision must be float or double", m_spec));
+    }
+    void build(BvhBuildConfig& b) {
+        number("bins", b.bins, 2, 256);
+        number("leaf", b.max_leaf_size, 1, 256);
+        number("traversal_cost", b.traversal_cost, 0, 1e6);
+        number("intersection_cost", b.intersection_cost, 1e-6, 1e6);
+    }
+    /// Throws for options no backend setting consumed.
+    void check_all_used(const char* valid) const {
+        for (const Option& o : m_options)
+            if (!o.used)
+                throw Error(fmt::format("accelerator '{}': unknown option '{}' (valid for {}: {})", m_spec, o.key, m_name,
+                                        valid));
+    }
+
+private:
+    struct Option {
+        std::string key, value;
+        bool used;
+    };
+    std::string m_spec, m_name;
+    std::vector<Option> m_options;
+};
+
+}  // namespace
+
+const std::vector<std::string>& accelerator_names() {
+    static const std::vector<std::string> names{"embree", "bvh", "grid", "octree", "kdop", "brute"};
+    return names;
+}
+
 std::unique_ptr<Accelerator> create_accelerator(const std::string& name, const Scene& scene,
                                                 const SurfaceFilter& filter, const AccelConfig& config) {
-    if (name == "embree") return create_embree_accelerator(scene, filter, EmbreeConfig{config.robust, config.threads});
-    throw Error(fmt::format("unknown accelerator '{}' (available: embree)", name));
+    AccelSpec spec(name);
+    std::unique_ptr<Accelerator> accel;
+    if (spec.name() == "embree") {
+        spec.check_all_used("none");
+        return create_embree_accelerator(scene, filter, EmbreeConfig{config.robust, config.threads});
+    }
+    if (spec.name() == "bvh") {
+        BvhConfig c;
+        spec.precision(c.precision);
+        spec.build(c.build);
+        if (const std::string* bv = spec.find("bv")) {
+            if (*bv == "aabb") c.volume = BoundingVolume::Aabb;
+            else if (*bv == "sphere") c.volume = BoundingVolume::Sphere;
+            else throw Error(fmt::format("accelerator '{}': bv must be aabb or sphere", name));
+        }
+        spec.check_all_used("precision, bv, bins, leaf, traversal_cost, intersection_cost");
+        return create_bvh_accelerator(scene, filter, c);
+    }
+    if (spec.name() == "kdop") {
+        KdopConfig c;
+        spec.build(c.build);
+        spec.check_all_used("bins, leaf, traversal_cost, intersection_cost");
+        return create_kdop_accelerator(scene, filter, c);
+    }
+    if (spec.name() == "brute") {
+        BruteForceConfig c;
+        spec.precision(c.precision);
+        spec.check_all_used("precision");
+        return create_brute_force_accelerator(scene, filter, c);
+    }
+    if (spec.name() == "grid") {
+        GridConfig c;
+        spec.number("lambda", c.lambda, 0.01, 1000);
+        spec.number("max_res", c.max_resolution, 1, 4096);
+        spec.check_all_used("lambda, max_res");
+        return create_grid_accelerator(scene, filter, c);
+    }
+    if (spec.name() == "octree") {
+        OctreeConfig c;
+        spec.number("leaf", c.max_leaf_size, 1, 1e6);
+        spec.number("depth", c.max_depth, 0, 20);
+        spec.check_all_used("leaf, depth");
+        return create_octree_accelerator(scene, filter, c);
+    }
+    throw Error(fmt::format("unknown accelerator '{}' (available: embree, bvh, grid, octree, kdop, brute)", spec.name()));
 }
 
 }  // namespace whitted

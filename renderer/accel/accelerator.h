@@ -4,6 +4,7 @@
 //   auto accel = create_accelerator("embree", scene, filter, config);   // builds once
 //   Hit h = accel->intersect(ray, RayKind::Camera);                      // closest hit
 //   Color s = accel->transmittance(shadow_ray);                          // product of Kt along it
+//   auto ref = create_accelerator("bvh:precision=double", scene, filter); // double-precision reference
 //
 // The interface is virtual only at the per-ray boundary; traversal inside a backend is inlined.
 // A hit is the minimal record {t, u, v, prim, geom, inst}; shading data (normals, UVs, material)
@@ -18,6 +19,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "renderer/core/vecmath.h"
 
@@ -72,6 +74,9 @@ public:
 struct AccelStats {
     double build_seconds = 0.0;
     size_t bytes = 0;                         ///< memory the structure holds, when known
+    size_t nodes = 0;                         ///< nodes / cells / voxels (0 when not known, e.g. Embree)
+    size_t references = 0;                    ///< primitive references in leaves or cells (0 = unknown)
+    double sah_cost = 0.0;                    ///< SAH cost of BVH-like trees, triangle-weighted (0 = n/a)
 };
 
 class Accelerator {
@@ -94,7 +99,13 @@ struct AccelConfig {
     int threads = 0;                          ///< 0 = all hardware threads (build)
 };
 
-/// Builds the named backend ("embree"); throws whitted::Error for an unknown name.
+/// The backend names create_accelerator knows, production default first.
+const std::vector<std::string>& accelerator_names();
+
+/// Builds the named backend: "embree", "bvh", "grid", "octree", "kdop" or "brute" (the O(n)
+/// oracle), optionally followed by options, e.g. "bvh:precision=double,bv=sphere" or
+/// "grid:lambda=8" (docs/accelerators.md lists them). Throws whitted::Error naming the valid
+/// choices for an unknown name or option.
 std::unique_ptr<Accelerator> create_accelerator(const std::string& name, const Scene& scene,
                                                 const SurfaceFilter& filter, const AccelConfig& config = {});
 

@@ -11,6 +11,7 @@ Film::Film(int full_width_, int full_height_, PixelWindow window_, AovSet aovs_)
     if (aovs.albedo) albedo.assign(n, Color(0.f));
     if (aovs.prim_id) prim_id.assign(n, 0xffffffffu);
     if (aovs.inst_id) inst_id.assign(n, 0xffffffffu);
+    if (aovs.aa_samples) aa_samples.assign(n, 0.f);
 }
 
 }  // namespace whitted

@@ -10,14 +10,19 @@
 
 namespace whitted {
 
-/// Which arbitrary output variables to keep (from the pixel-centre camera ray; not filtered).
+/// Which arbitrary output variables to keep (geometric ones from the pixel-centre camera ray; not
+/// filtered).
 struct AovSet {
     bool depth = false;     ///< camera-space distance along the ray (t * |dir|), inf when missed
     bool normal = false;    ///< world-space shading normal, 0 when missed
     bool albedo = false;    ///< kd + kr + kt at the first hit (a denoiser-style albedo)
     bool prim_id = false;   ///< triangle index within its mesh, -1 (as uint max) when missed
     bool inst_id = false;   ///< instance index, -1 when missed
-    bool any() const { return depth || normal || albedo || prim_id || inst_id; }
+    bool aa_samples = false;  ///< primary sample points the pixel's estimate uses (1 center, 4 corners,
+                              ///< 4..(2^d+1)^2 adaptive, spp stratified); see docs/antialiasing.md
+    /// True when a pixel-centre first hit is needed (every AOV but aa_samples).
+    bool needs_first_hit() const { return depth || normal || albedo || prim_id || inst_id; }
+    bool any() const { return needs_first_hit() || aa_samples; }
 };
 
 /// Region [x0, x1) x [y0, y1) of the full image (the EXR data window).
@@ -38,6 +43,7 @@ struct Film {
     std::vector<Color> albedo;
     std::vector<uint32_t> prim_id;
     std::vector<uint32_t> inst_id;
+    std::vector<float> aa_samples;
 
     Film() = default;
     /// Allocates the buffers for `window` of a full_width x full_height image.

@@ -62,4 +62,10 @@ Ray CameraModel::generate(double x, double y) const {
     return r;
 }
 
+RayCone CameraModel::pixel_cone() const {
+    const double pixel = 2.0 * m_half_h / double(m_height);
+    if (m_type == CameraType::Perspective) return RayCone{0.f, float(pixel)};
+    return RayCone{float(pixel), 0.f};
+}
+
 }  // namespace whitted

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "renderer/accel/accelerator.h"
+#include "renderer/integrator/scene_view.h"
 #include "renderer/scene/scene.h"
 
 namespace whitted {
@@ -22,6 +23,10 @@ public:
     /// Ray through image position (x, y) in pixels, (0, 0) = top-left corner of the image,
     /// (width, height) = bottom-right; pixel centres are at +0.5. Direction is unit length.
     Ray generate(double x, double y) const;
+    /// Footprint of one pixel as a ray cone: perspective cameras spread by the angle one pixel
+    /// subtends at the image centre (2 tan(yfov/2) / height), orthographic ones have a constant
+    /// width of one pixel. Used for texture MIP selection, whatever the anti-aliasing mode.
+    RayCone pixel_cone() const;
 
 private:
     CameraType m_type;

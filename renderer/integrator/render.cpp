@@ -1,5 +1,6 @@
 #include "renderer/integrator/render.h"
 
+#include <tbb/concurrent_hash_map.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -8,6 +9,7 @@
 #include <xmmintrin.h>
 #include <pmmintrin.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -111,6 +113,8 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
         throw Error(fmt::format("--crop {},{},{},{} is not a non-empty region inside the {}x{} image", m_window.x0,
                                 m_window.y0, m_window.x1, m_window.y1, m_size.width, m_size.height));
 
+    validate_aa_settings(settings.aa);
+
     set_ftz_daz();
     auto start = Clock::now();
     m_accel = create_accelerator(settings.accel, scene, m_view, AccelConfig{settings.robust, settings.threads});
@@ -119,59 +123,296 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
 
 Renderer::~Renderer() = default;
 
-Film Renderer::render(RenderStats* stats) const {
+namespace {
+
+/// A rectangle of pixels [x0, x1) x [y0, y1) in full-image coordinates.
+struct Rect {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+/// Adaptive samples on pixel edges (not corners), keyed by their position on the 2^depth lattice of
+/// the full image. Each is used by at most the two pixels sharing the edge, possibly in different
+/// tiles: the first request traces it while holding the element's write lock (a concurrent request
+/// for the same point waits instead of tracing it again), the second one removes it, so the map
+/// only holds the points whose second user has not run yet.
+class EdgeSamples {
+public:
+    template <typename Trace>
+    Color get(uint64_t key, Trace&& trace) {
+        Map::accessor a;
+        if (m_map.insert(a, key)) {
+            a->second.value = trace();
+            a->second.uses = 1;
+            return a->second.value;
+        }
+        const Color value = a->second.value;
+        if (++a->second.uses == 2) m_map.erase(a);
+        return value;
+    }
+
+private:
+    struct Entry {
+        Color value{0.f};
+        int uses = 0;
+    };
+    using Map = tbb::concurrent_hash_map<uint64_t, Entry>;
+    Map m_map;
+};
+
+/// Per-thread grid of one pixel's adaptive samples: (2^depth + 1)^2 points; a point is valid when
+/// its stamp equals the current generation, so nothing is cleared between pixels.
+struct AdaptiveScratch {
+    std::vector<Color> value;
+    std::vector<uint32_t> stamp;
+    uint32_t generation = 0;
+};
+
+/// Everything one render() call shares between its tiles.
+class Frame {
+public:
+    Frame(const CameraModel& camera, const WhittedIntegrator& integrator, Film& film, const AaSettings& aa,
+          float exposure)
+        : m_camera(camera), m_integrator(integrator), m_film(film), m_aa(aa), m_exposure(exposure),
+          m_cone(camera.pixel_cone()), m_n(1 << aa.depth) {
+        if (aa.mode == AaMode::Corners || aa.mode == AaMode::Adaptive)
+            m_lattice.assign(size_t(film.width() + 1) * size_t(film.height() + 1), Color(0.f));
+    }
+
+    /// One primary sample at image position (x, y): exposure-scaled radiance, never NaN/inf.
+    Color sample(double x, double y, RayCounters& rc, PrimaryInfo* info = nullptr) {
+        const Ray ray = m_camera.generate(x, y);
+        Color c = m_integrator.trace(ray, RayKind::Camera, 0, rc, info, m_cone) * m_exposure;
+        if (!is_finite(c)) {
+            ++m_nonfinite;
+            c = Color(0.f);
+        }
+        return c;
+    }
+
+    /// center: one ray through each pixel centre (it also gives the AOVs).
+    void center_tile(const Rect& r, RayCounters& rc) {
+        for (int y = r.y0; y < r.y1; ++y)
+            for (int x = r.x0; x < r.x1; ++x) {
+                PrimaryInfo info;
+                const Color c = sample(x + 0.5, y + 0.5, rc, m_film.aovs.needs_first_hit() ? &info : nullptr);
+                finish_pixel(x, y, c, 1.f, &info, rc);
+            }
+    }
+
+    /// stratified: k x k jittered samples, box or tent filter importance-sampled, equal weights.
+    void stratified_tile(const Rect& r, RayCounters& rc) {
+        const int k = stratified_side(m_aa.spp);
+        const double inv_k = 1.0 / k;
+        for (int y = r.y0; y < r.y1; ++y)
+            for (int x = r.x0; x < r.x1; ++x) {
+                // Seeded by the full-image pixel index: crops and tiles see the same jitter.
+                const uint64_t pixel = uint64_t(y) * uint64_t(m_film.full_width) + uint64_t(x);
+                Color sum(0.f);
+                for (int j = 0; j < k; ++j)
+                    for (int i = 0; i < k; ++i) {
+                        const uint64_t key = ((pixel << 12 | uint64_t(j * k + i)) << 1);
+                        const double u = (i + double(hash_to_unit_float(key))) * inv_k;
+                        const double v = (j + double(hash_to_unit_float(key | 1))) * inv_k;
+                        double sx = x + u, sy = y + v;
+                        if (m_aa.filter == PixelFilter::Tent) {
+                            sx = x + 0.5 + double(sample_tent(float(u)));
+                            sy = y + 0.5 + double(sample_tent(float(v)));
+                        }
+                        sum += sample(sx, sy, rc);
+                    }
+                finish_pixel(x, y, sum * float(1.0 / m_aa.spp), float(m_aa.spp), nullptr, rc);
+            }
+    }
+
+    /// Lattice pass (corners, adaptive): the tile traces the pixel corners at its top-left; the
+    /// tiles on the window's right and bottom edges also trace the closing column and row, so every
+    /// corner of the (w+1)(h+1) lattice is traced exactly once.
+    void lattice_tile(const Rect& r, RayCounters& rc) {
+        const PixelWindow& w = m_film.window;
+        const int cx1 = r.x1 == w.x1 ? r.x1 + 1 : r.x1;
+        const int cy1 = r.y1 == w.y1 ? r.y1 + 1 : r.y1;
+        for (int y = r.y0; y < cy1; ++y)
+            for (int x = r.x0; x < cx1; ++x) m_lattice[lattice_index(x, y)] = sample(x, y, rc);
+    }
+
+    /// corners: pixel = mean of its 4 lattice corners.
+    void corners_tile(const Rect& r, RayCounters& rc) {
+        for (int y = r.y0; y < r.y1; ++y)
+            for (int x = r.x0; x < r.x1; ++x) {
+                const Color c = (corner(x, y) + corner(x + 1, y) + corner(x, y + 1) + corner(x + 1, y + 1)) * 0.25f;
+                finish_pixel(x, y, c, 4.f, nullptr, rc);
+            }
+    }
+
+    /// adaptive (Whitted 1980): recursive subdivision of each pixel square from its lattice corners.
+    void adaptive_tile(const Rect& r, RayCounters& rc, AdaptiveScratch& scratch) {
+        const size_t points = size_t(m_n + 1) * size_t(m_n + 1);
+        if (scratch.value.size() != points) {
+            scratch.value.assign(points, Color(0.f));
+            scratch.stamp.assign(points, 0u);
+            scratch.generation = 0;
+        }
+        for (int y = r.y0; y < r.y1; ++y)
+            for (int x = r.x0; x < r.x1; ++x) {
+                if (++scratch.generation == 0) {  // wrapped: invalidate every stamp once
+                    std::fill(scratch.stamp.begin(), scratch.stamp.end(), 0u);
+                    scratch.generation = 1;
+                }
+                PixelRecursion p{x, y, 0, false};
+                const Color c = subdivide(p, scratch, rc, 0, 0, m_n, 0);
+                if (p.split) ++m_subdivided;
+                finish_pixel(x, y, c, float(p.points), nullptr, rc);
+            }
+    }
+
+    uint64_t nonfinite() const { return m_nonfinite.load(); }
+    uint64_t subdivided() const { return m_subdivided.load(); }
+
+private:
+    struct PixelRecursion {
+        int x, y;        ///< pixel
+        int points;      ///< distinct sample points used
+        bool split;      ///< the pixel square was split
+    };
+
+    size_t lattice_index(int x, int y) const {
+        return size_t(y - m_film.window.y0) * size_t(m_film.width() + 1) + size_t(x - m_film.window.x0);
+    }
+    const Color& corner(int x, int y) const { return m_lattice[lattice_index(x, y)]; }
+
+    /// Sample (i, j) of pixel p's (n+1) x (n+1) grid: lattice corner, shared edge point or interior
+    /// point, each fetched or traced at most once per pixel.
+    const Color& point(PixelRecursion& p, AdaptiveScratch& s, RayCounters& rc, int i, int j) {
+        const size_t k = size_t(j) * size_t(m_n + 1) + size_t(i);
+        if (s.stamp[k] == s.generation) return s.value[k];
+        s.stamp[k] = s.generation;
+        ++p.points;
+        const int n = m_n;
+        const double inv_n = 1.0 / n;
+        const bool on_x = i == 0 || i == n, on_y = j == 0 || j == n;
+        if (on_x && on_y) {
+            s.value[k] = corner(p.x + i / n, p.y + j / n);
+        } else if (on_x || on_y) {
+            // On the pixel's border: shared with the neighbour across that edge.
+            const uint64_t gx = uint64_t(p.x) * uint64_t(n) + uint64_t(i), gy = uint64_t(p.y) * uint64_t(n) + uint64_t(j);
+            s.value[k] = m_edges.get(gx << 32 | gy, [&] { return sample(p.x + i * inv_n, p.y + j * inv_n, rc); });
+        } else {
+            s.value[k] = sample(p.x + i * inv_n, p.y + j * inv_n, rc);
+        }
+        return s.value[k];
+    }
+
+    /// Area-weighted radiance of the sub-square with top-left grid point (i, j) and side `size`
+    /// grid steps at subdivision `level`: split into 4 while the corners differ by more than the
+    /// threshold, else the mean of its 4 corners.
+    Color subdivide(PixelRecursion& p, AdaptiveScratch& s, RayCounters& rc, int i, int j, int size, int level) {
+        const Color c00 = point(p, s, rc, i, j), c10 = point(p, s, rc, i + size, j);
+        const Color c01 = point(p, s, rc, i, j + size), c11 = point(p, s, rc, i + size, j + size);
+        if (level < m_aa.depth && aa_contrast(c00, c10, c01, c11) > m_aa.threshold) {
+            if (level == 0) p.split = true;
+            const int h = size / 2;
+            return subdivide(p, s, rc, i, j, h, level + 1) + subdivide(p, s, rc, i + h, j, h, level + 1) +
+                   subdivide(p, s, rc, i, j + h, h, level + 1) + subdivide(p, s, rc, i + h, j + h, h, level + 1);
+        }
+        // Leaf: mean of the corners times the area (a power of 2, exact) as a fraction of the pixel.
+        const float area = float(size) * float(size) / (float(m_n) * float(m_n));
+        return (c00 + c10 + c01 + c11) * (0.25f * area);
+    }
+
+    /// Stores a pixel and its AOVs (probing the pixel centre when the mode traced no centre ray).
+    void finish_pixel(int x, int y, const Color& c, float samples, const PrimaryInfo* info, RayCounters& rc) {
+        const size_t i = m_film.index(x, y);
+        m_film.beauty[i] = c;
+        if (m_film.aovs.aa_samples) m_film.aa_samples[i] = samples;
+        if (!m_film.aovs.needs_first_hit()) return;
+        PrimaryInfo probed;
+        if (!info) {
+            m_integrator.probe(m_camera.generate(x + 0.5, y + 0.5), rc, probed);
+            info = &probed;
+        }
+        if (m_film.aovs.depth) m_film.depth[i] = info->depth;
+        if (m_film.aovs.normal) m_film.normal[i] = info->normal;
+        if (m_film.aovs.albedo) m_film.albedo[i] = info->albedo;
+        if (m_film.aovs.prim_id) m_film.prim_id[i] = info->prim;
+        if (m_film.aovs.inst_id) m_film.inst_id[i] = info->inst;
+    }
+
+    const CameraModel& m_camera;
+    const WhittedIntegrator& m_integrator;
+    Film& m_film;
+    const AaSettings& m_aa;
+    const float m_exposure;
+    const RayCone m_cone;
+    const int m_n;                       ///< adaptive grid steps per pixel side, 2^depth
+    std::vector<Color> m_lattice;        ///< (w+1) x (h+1) pixel-corner samples of the window
+    EdgeSamples m_edges;
+    std::atomic<uint64_t> m_nonfinite{0};
+    std::atomic<uint64_t> m_subdivided{0};
+};
+
+}  // namespace
+
+Film Renderer::render(RenderStats* stats) const { return render(m_settings.aa, stats); }
+
+Film Renderer::render(const AaSettings& aa, RenderStats* stats) const {
+    validate_aa_settings(aa);
     const Camera& cam = m_scene.cameras[size_t(m_settings.camera)];
     const CameraModel camera(cam, m_size.width, m_size.height);
     const WhittedIntegrator integrator(m_view, *m_accel, m_settings.integrator);
     Film film(m_size.width, m_size.height, m_window, m_settings.aovs);
+    Frame frame(camera, integrator, film, aa, m_settings.exposure);
 
     // Tiles in row-major order over the window.
     const int ts = m_settings.tile_size;
     const int tiles_x = (m_window.width() + ts - 1) / ts;
     const int tiles_y = (m_window.height() + ts - 1) / ts;
     const size_t tile_count = size_t(tiles_x) * size_t(tiles_y);
+    const bool lattice = aa.mode == AaMode::Corners || aa.mode == AaMode::Adaptive;
 
     tbb::enumerable_thread_specific<RayCounters> counters;
-    std::atomic<uint64_t> nonfinite{0};
-    ProgressBar progress(tile_count, m_settings.progress);
+    tbb::enumerable_thread_specific<AdaptiveScratch> scratch;
+    ProgressBar progress(tile_count * (lattice ? 2 : 1), m_settings.progress);
 
     const int threads = m_settings.threads > 0 ? m_settings.threads : tbb::this_task_arena::max_concurrency();
     tbb::task_arena arena(threads);
     FtzObserver observer(arena);
     set_ftz_daz();
 
-    auto start = Clock::now();
-    arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, tile_count, 1), [&](const tbb::blocked_range<size_t>& range) {
-            RayCounters& rc = counters.local();
-            for (size_t tile = range.begin(); tile != range.end(); ++tile) {
-                const int tx = int(tile % size_t(tiles_x)), ty = int(tile / size_t(tiles_x));
-                const int x0 = m_window.x0 + tx * ts, y0 = m_window.y0 + ty * ts;
-                const int x1 = std::min(x0 + ts, m_window.x1), y1 = std::min(y0 + ts, m_window.y1);
-                for (int y = y0; y < y1; ++y) {
-                    for (int x = x0; x < x1; ++x) {
-                        // One camera ray through the pixel centre (anti-aliasing modes come later).
-                        const Ray ray = camera.generate(x + 0.5, y + 0.5);
-                        PrimaryInfo info;
-                        Color c = integrator.trace(ray, RayKind::Camera, 0, rc, film.aovs.any() ? &info : nullptr);
-                        c *= m_settings.exposure;
-                        if (!is_finite(c)) {
-                            ++nonfinite;
-                            c = Color(0.f);
-                        }
-                        const size_t i = film.index(x, y);
-                        film.beauty[i] = c;
-                        if (film.aovs.depth) film.depth[i] = info.depth;
-                        if (film.aovs.normal) film.normal[i] = info.normal;
-                        if (film.aovs.albedo) film.albedo[i] = info.albedo;
-                        if (film.aovs.prim_id) film.prim_id[i] = info.prim;
-                        if (film.aovs.inst_id) film.inst_id[i] = info.inst;
-                    }
+    // Runs `body(tile rectangle, counters)` over every tile in parallel.
+    auto for_each_tile = [&](auto&& body) {
+        arena.execute([&] {
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, tile_count, 1), [&](const tbb::blocked_range<size_t>& range) {
+                RayCounters& rc = counters.local();
+                for (size_t tile = range.begin(); tile != range.end(); ++tile) {
+                    const int tx = int(tile % size_t(tiles_x)), ty = int(tile / size_t(tiles_x));
+                    Rect r;
+                    r.x0 = m_window.x0 + tx * ts;
+                    r.y0 = m_window.y0 + ty * ts;
+                    r.x1 = std::min(r.x0 + ts, m_window.x1);
+                    r.y1 = std::min(r.y0 + ts, m_window.y1);
+                    body(r, rc);
+                    progress.advance();
                 }
-                progress.advance();
-            }
+            });
         });
-    });
+    };
+
+    auto start = Clock::now();
+    switch (aa.mode) {
+        case AaMode::Center: for_each_tile([&](const Rect& r, RayCounters& rc) { frame.center_tile(r, rc); }); break;
+        case AaMode::Stratified:
+            for_each_tile([&](const Rect& r, RayCounters& rc) { frame.stratified_tile(r, rc); });
+            break;
+        case AaMode::Corners:
+        case AaMode::Adaptive:
+            // Pass 1 traces the shared corner lattice, pass 2 reduces (corners) or refines (adaptive).
+            for_each_tile([&](const Rect& r, RayCounters& rc) { frame.lattice_tile(r, rc); });
+            if (aa.mode == AaMode::Corners)
+                for_each_tile([&](const Rect& r, RayCounters& rc) { frame.corners_tile(r, rc); });
+            else
+                for_each_tile([&](const Rect& r, RayCounters& rc) { frame.adaptive_tile(r, rc, scratch.local()); });
+            break;
+    }
     progress.finish();
 
     if (stats) {
@@ -179,10 +420,12 @@ Film Renderer::render(RenderStats* stats) const {
         stats->render_seconds = std::chrono::duration<double>(Clock::now() - start).count();
         stats->rays = RayCounters{};
         for (const RayCounters& rc : counters) stats->rays += rc;
-        stats->nonfinite_samples = nonfinite.load();
+        stats->nonfinite_samples = frame.nonfinite();
+        stats->pixels = uint64_t(m_window.width()) * uint64_t(m_window.height());
+        stats->pixels_subdivided = frame.subdivided();
         stats->threads = threads;
     }
-    if (nonfinite.load() > 0) log_warning("{} samples were not finite and were set to 0", nonfinite.load());
+    if (frame.nonfinite() > 0) log_warning("{} samples were not finite and were set to 0", frame.nonfinite());
     return film;
 }
 

@@ -1,6 +1,8 @@
 // Renderer: builds the accelerator for a scene once and renders it tile by tile over TBB.
-// The image is bit-identical whatever the thread count or tile size: every pixel is computed
-// independently from its own camera ray, there are no float reductions across threads.
+// The image is bit-identical whatever the thread count or tile size: every primary sample's
+// radiance is a pure function of its image position, each pixel is reduced from its samples in a
+// fixed order, and there are no float reductions across threads. Samples shared between pixels
+// (corner lattice, adaptive edge points) are traced exactly once (docs/antialiasing.md).
 #pragma once
 
 #include <memory>
@@ -9,6 +11,7 @@
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/film/film.h"
+#include "renderer/integrator/aa_sampler.h"
 #include "renderer/integrator/camera.h"
 #include "renderer/integrator/scene_view.h"
 #include "renderer/integrator/whitted_integrator.h"
@@ -25,6 +28,7 @@ struct RenderSettings {
     int threads = 0;                      ///< 0 = all hardware threads
     std::optional<PixelWindow> crop;      ///< render only this region of the full image
     AovSet aovs;                          ///< extra outputs from the pixel-centre camera ray
+    AaSettings aa;                        ///< anti-aliasing mode and its parameters
     std::string accel = "embree";         ///< accelerator backend
     bool robust = false;                  ///< Embree ROBUST mode
     bool progress = false;                ///< progress bar with ETA on stderr (when it is a terminal)
@@ -35,6 +39,8 @@ struct RenderStats {
     double render_seconds = 0.0;          ///< tracing all tiles
     RayCounters rays;
     uint64_t nonfinite_samples = 0;       ///< samples that were NaN/inf and were replaced by 0
+    uint64_t pixels = 0;                  ///< pixels rendered (the window)
+    uint64_t pixels_subdivided = 0;       ///< adaptive: pixels whose square was split at least once
     int threads = 0;                      ///< worker threads used
 };
 
@@ -45,8 +51,11 @@ public:
     Renderer(const Scene& scene, const RenderSettings& settings);
     ~Renderer();
 
-    /// Renders the (cropped) image. Safe to call repeatedly.
+    /// Renders the (cropped) image with the settings' anti-aliasing. Safe to call repeatedly.
     Film render(RenderStats* stats = nullptr) const;
+    /// Renders with another anti-aliasing setting (benchmarks sweep settings on one accelerator).
+    /// Throws whitted::Error when `aa` is out of range.
+    Film render(const AaSettings& aa, RenderStats* stats = nullptr) const;
 
     ImageSize image_size() const { return m_size; }
     const Accelerator& accelerator() const { return *m_accel; }

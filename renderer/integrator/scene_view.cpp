@@ -35,12 +35,27 @@ T interpolate(const std::vector<T>& a, uint32_t i0, uint32_t i1, uint32_t i2, fl
 }
 
 /// Texture lookup through a material's reference; (1,1,1,1) when the reference is empty.
-Vec4f lookup(const Scene& scene, const TextureRef& ref, const Vec2f uv[2]) {
+/// `uv_lod` (per UV set, see SurfacePoint::uv_lod) gives the MIP level: the footprint in texels is
+/// its width in UV units times the texture size (geometric mean of width and height) times the
+/// scale of KHR_texture_transform; -inf selects level 0 with the magnification filter.
+Vec4f lookup(const Scene& scene, const TextureRef& ref, const Vec2f uv[2], const float uv_lod[2]) {
     if (!ref.valid() || size_t(ref.texture) >= scene.textures.size()) return {1.f, 1.f, 1.f, 1.f};
-    Vec2f t = uv[ref.uv_set > 1 ? 0 : ref.uv_set];
-    if (!ref.transform.identity()) t = apply_texture_transform(ref.transform, t);
-    return sample_texture(scene.textures[size_t(ref.texture)], t, 0.f);
+    const uint32_t set = ref.uv_set > 1 ? 0 : ref.uv_set;
+    Vec2f t = uv[set];
+    float lod = uv_lod[set];
+    const Texture& texture = scene.textures[size_t(ref.texture)];
+    if (!ref.transform.identity()) {
+        t = apply_texture_transform(ref.transform, t);
+        const float area_scale = std::abs(ref.transform.scale.x * ref.transform.scale.y);
+        if (area_scale > 0.f) lod += 0.5f * std::log2(area_scale);
+    }
+    if (lod > -kInfinity && !texture.levels.empty())
+        lod += 0.5f * std::log2(float(texture.levels[0].width) * float(texture.levels[0].height));
+    return sample_texture(texture, t, lod);
 }
+
+/// Point lookups (no footprint): alpha tests during traversal and shadow transmittance.
+constexpr float kNoFootprint[2] = {-kInfinity, -kInfinity};
 
 }  // namespace
 
@@ -81,7 +96,7 @@ Vec3f SceneView::world_geometric_normal(const Hit& hit) const {
     return cross(p1 - p0, p2 - p0);
 }
 
-SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit) const {
+SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& cone) const {
     SurfacePoint sp;
     const Mesh& mesh = m_scene.meshes[hit.geom];
     const InstanceXf& xf = m_xf[hit.inst];
@@ -119,6 +134,24 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit) const {
     if (!mesh.uv1.empty()) sp.uv[1] = interpolate(mesh.uv1, i0, i1, i2, u, v);
     if (!mesh.colors.empty()) sp.color = interpolate(mesh.colors, i0, i1, i2, u, v);
 
+    // Texture footprint (Akenine-Moeller et al. 2019, ray cones): the cone's width at the hit,
+    // stretched by 1/|cos| on the surface, converted to UV units by sqrt(uv area / world area)
+    // of the triangle (its UV parameterisation's mean scale). Isotropic: no anisotropic filtering.
+    const float width = cone.width_at(hit.t);
+    if (width > 0.f) {
+        const float world_area = length(cross(p1 - p0, p2 - p0));
+        const float cos_theta = std::max(std::abs(dot(ng, ray.dir)), 1e-3f);
+        auto footprint = [&](const std::vector<Vec2f>& uvs) {
+            const Vec2f a = uvs[i0], b = uvs[i1], c = uvs[i2];
+            const float uv_area = std::abs((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y));
+            if (!(uv_area > 0.f) || !(world_area > 0.f)) return -kInfinity;
+            const float lod = std::log2(width / cos_theta) + 0.5f * std::log2(uv_area / world_area);
+            return std::isfinite(lod) ? lod : -kInfinity;
+        };
+        if (!mesh.uv0.empty()) sp.uv_lod[0] = footprint(mesh.uv0);
+        if (!mesh.uv1.empty()) sp.uv_lod[1] = footprint(mesh.uv1);
+    }
+
     // Shading normal: interpolated vertex normals, then the normal map.
     Vec3f ns = ng;
     if (!mesh.normals.empty()) {
@@ -132,7 +165,7 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit) const {
         t = normalize(t - ns * dot(ns, t));  // Gram-Schmidt against the shading normal
         if (t != Vec3f(0.f)) {
             Vec3f b = cross(ns, t) * (t4.w < 0.f ? -1.f : 1.f);
-            Vec4f tex = lookup(m_scene, mat.normal_texture, sp.uv);
+            Vec4f tex = lookup(m_scene, mat.normal_texture, sp.uv, sp.uv_lod);
             float s = mat.normal_texture.scale;
             Vec3f m{(tex.x * 2.f - 1.f) * s, (tex.y * 2.f - 1.f) * s, tex.z * 2.f - 1.f};
             Vec3f mapped = normalize(t * m.x + b * m.y + ns * m.z);
@@ -145,21 +178,21 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit) const {
 
 PbrSample SceneView::material_inputs(const Material& m, const SurfacePoint& sp) const {
     PbrSample s;
-    Vec4f bc = lookup(m_scene, m.base_color_texture, sp.uv);
+    Vec4f bc = lookup(m_scene, m.base_color_texture, sp.uv, sp.uv_lod);
     s.base_color = {m.base_color.x * bc.x * sp.color.x, m.base_color.y * bc.y * sp.color.y,
                     m.base_color.z * bc.z * sp.color.z, m.base_color.w * bc.w * sp.color.w};
-    Vec4f mr = lookup(m_scene, m.metallic_roughness_texture, sp.uv);
+    Vec4f mr = lookup(m_scene, m.metallic_roughness_texture, sp.uv, sp.uv_lod);
     s.metallic = std::clamp(m.metallic * mr.z, 0.f, 1.f);
     s.roughness = std::clamp(m.roughness * mr.y, 0.f, 1.f);
-    s.transmission = std::clamp(m.transmission * lookup(m_scene, m.transmission_texture, sp.uv).x, 0.f, 1.f);
+    s.transmission = std::clamp(m.transmission * lookup(m_scene, m.transmission_texture, sp.uv, sp.uv_lod).x, 0.f, 1.f);
     if (m.occlusion_texture.valid()) {
-        float occ = lookup(m_scene, m.occlusion_texture, sp.uv).x;
+        float occ = lookup(m_scene, m.occlusion_texture, sp.uv, sp.uv_lod).x;
         s.occlusion = 1.f + m.occlusion_texture.scale * (occ - 1.f);
     }
-    Vec4f em = lookup(m_scene, m.emissive_texture, sp.uv);
+    Vec4f em = lookup(m_scene, m.emissive_texture, sp.uv, sp.uv_lod);
     s.emissive = m.emissive * em.xyz() * m.emissive_strength;
-    s.specular = m.specular * lookup(m_scene, m.specular_texture, sp.uv).w;
-    s.specular_color = m.specular_color * lookup(m_scene, m.specular_color_texture, sp.uv).xyz();
+    s.specular = m.specular * lookup(m_scene, m.specular_texture, sp.uv, sp.uv_lod).w;
+    s.specular_color = m.specular_color * lookup(m_scene, m.specular_color_texture, sp.uv, sp.uv_lod).xyz();
     return s;
 }
 
@@ -177,7 +210,7 @@ float SceneView::alpha_at(const Material& m, const Hit& hit) const {
     Vec2f uv[2];
     if (!mesh.uv0.empty()) uv[0] = interpolate(mesh.uv0, i0, i1, i2, hit.u, hit.v);
     if (!mesh.uv1.empty()) uv[1] = interpolate(mesh.uv1, i0, i1, i2, hit.u, hit.v);
-    float a = m.base_color.w * lookup(m_scene, m.base_color_texture, uv).w;
+    float a = m.base_color.w * lookup(m_scene, m.base_color_texture, uv, kNoFootprint).w;
     if (!mesh.colors.empty()) a *= interpolate(mesh.colors, i0, i1, i2, hit.u, hit.v).w;
     return std::clamp(a, 0.f, 1.f);
 }

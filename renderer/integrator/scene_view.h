@@ -11,6 +11,16 @@
 
 namespace whitted {
 
+/// A ray cone (Amanatides 1984; Akenine-Moeller et al., "Texture Level of Detail Strategies for
+/// Real-Time Ray Tracing", Ray Tracing Gems 2019): the footprint of a ray is `width + spread * t`
+/// world units at distance t. {0, 0} = a point sample (textures use their finest level).
+struct RayCone {
+    float width = 0.f;          ///< footprint width at the ray origin (world units)
+    float spread = 0.f;         ///< growth of the width per unit distance (radians, small angle)
+    /// Width at distance t along a unit-direction ray.
+    float width_at(float t) const { return width + spread * t; }
+};
+
 /// Everything the integrator needs about one hit point (world space).
 struct SurfacePoint {
     Vec3f p;                    ///< position, interpolated from the triangle's world-space vertices
@@ -21,14 +31,18 @@ struct SurfacePoint {
     Vec2f uv[2];                ///< TEXCOORD_0/1 (0 when absent)
     Vec4f color{1.f, 1.f, 1.f, 1.f};  ///< COLOR_0 (1 when absent)
     uint32_t material = 0;
+    float uv_lod[2] = {-kInfinity, -kInfinity};  ///< log2 of the footprint's width in UV units per
+                                ///< UV set (ray cone / |cos| x sqrt(uv area / world area));
+                                ///< -inf = no footprint (point sample, finest MIP level)
 };
 
 class SceneView final : public SurfaceFilter {
 public:
     SceneView(const Scene& scene, const MappingOptions& mapping);
 
-    /// Full surface data at a hit of `ray`.
-    SurfacePoint surface(const Ray& ray, const Hit& hit) const;
+    /// Full surface data at a hit of unit-direction `ray`; `cone` is the ray's footprint, which
+    /// selects texture MIP levels (the default point cone samples the finest level).
+    SurfacePoint surface(const Ray& ray, const Hit& hit, const RayCone& cone = {}) const;
     /// Material inputs at a point (factors x textures x vertex color).
     PbrSample material_inputs(const Material& material, const SurfacePoint& sp) const;
     /// The seed's coefficients at a point.

@@ -28,17 +28,39 @@ Color exp_neg(const Color& c) { return {std::exp(-c.x), std::exp(-c.y), std::exp
 }  // namespace
 
 Color WhittedIntegrator::trace(const Ray& ray, RayKind kind, int depth, RayCounters& counters,
-                               PrimaryInfo* primary) const {
+                               PrimaryInfo* primary, const RayCone& cone) const {
     count(counters, kind);
     const Hit hit = m_accel.intersect(ray, kind);
     if (!hit.valid()) return m_settings.background;
-    return sanitize(shade(ray, hit, depth, counters, primary));
+    return sanitize(shade(ray, hit, depth, counters, primary, cone));
+}
+
+void WhittedIntegrator::probe(const Ray& ray, RayCounters& counters, PrimaryInfo& primary) const {
+    ++counters.aov_probe;
+    const Hit hit = m_accel.intersect(ray, RayKind::Camera);
+    if (!hit.valid()) return;
+    const SurfacePoint sp = m_view.surface(ray, hit);
+    const WhittedCoeffs c = m_view.coefficients(sp);
+    // The same orientation rules as shade().
+    const Vec3f V = -ray.dir;
+    const bool front = dot(sp.ng, V) >= 0.f;
+    Vec3f N = front ? sp.ns : -sp.ns;
+    if (dot(N, V) <= 0.f) N = front ? sp.ng : -sp.ng;
+    primary.hit = true;
+    primary.depth = hit.t;
+    primary.normal = N;
+    primary.albedo = c.kd + c.kr + c.kt;
+    primary.prim = hit.prim;
+    primary.inst = hit.inst;
 }
 
 Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCounters& counters,
-                               PrimaryInfo* primary) const {
+                               PrimaryInfo* primary, const RayCone& cone) const {
     const Scene& scene = m_view.scene();
-    const SurfacePoint sp = m_view.surface(ray, hit);
+    const SurfacePoint sp = m_view.surface(ray, hit, cone);
+    // Secondary rays start where this cone arrived and keep its spread. Surface curvature would
+    // widen (convex mirrors) or narrow it; it is ignored (flat-surface propagation).
+    const RayCone secondary{cone.width_at(hit.t), cone.spread};
     const Material& mat = scene.materials[sp.material];
     const WhittedCoeffs c = m_view.coefficients(sp);
 
@@ -123,7 +145,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                     else transmitted = false;  // total internal reflection
                 }
                 if (transmitted) {
-                    result += kt * trace(t, RayKind::Refraction, depth + 1, counters);
+                    result += kt * trace(t, RayKind::Refraction, depth + 1, counters, nullptr, secondary);
                 } else {
                     kr += kt;  // the transmitted energy goes to reflection
                 }
@@ -134,7 +156,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                 Ray r;
                 r.org = offset_ray_origin(sp.p, Ng);
                 r.dir = normalize(R);
-                result += kr * trace(r, RayKind::Reflection, depth + 1, counters);
+                result += kr * trace(r, RayKind::Reflection, depth + 1, counters, nullptr, secondary);
             }
         }
     }
@@ -149,7 +171,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
             Ray behind;
             behind.org = offset_ray_origin(sp.p, -Ng);
             behind.dir = ray.dir;
-            Color b = depth < m_settings.max_depth ? trace(behind, RayKind::Refraction, depth + 1, counters)
+            Color b = depth < m_settings.max_depth ? trace(behind, RayKind::Refraction, depth + 1, counters, nullptr, secondary)
                                                    : m_settings.background;
             result = result * alpha + b * (1.f - alpha);
         }

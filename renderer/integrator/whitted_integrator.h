@@ -16,11 +16,15 @@ struct IntegratorSettings {
 };
 
 /// Rays traced, by kind (summed per thread, then added: integer sums are deterministic).
+/// `camera` counts the primary rays whose radiance enters the image (the anti-aliasing samples);
+/// `aov_probe` counts first-hit-only rays through pixel centres that feed AOVs in modes without a
+/// centre sample.
 struct RayCounters {
-    uint64_t camera = 0, shadow = 0, reflection = 0, refraction = 0;
-    uint64_t total() const { return camera + shadow + reflection + refraction; }
+    uint64_t camera = 0, shadow = 0, reflection = 0, refraction = 0, aov_probe = 0;
+    uint64_t total() const { return camera + shadow + reflection + refraction + aov_probe; }
     RayCounters& operator+=(const RayCounters& o) {
         camera += o.camera; shadow += o.shadow; reflection += o.reflection; refraction += o.refraction;
+        aov_probe += o.aov_probe;
         return *this;
     }
 };
@@ -40,13 +44,19 @@ public:
         : m_view(view), m_accel(accel), m_settings(settings) {}
 
     /// Radiance arriving along `ray` (a unit-direction ray of the given kind at tree depth
-    /// `depth`). Never NaN or infinite. `primary` (optional) receives first-hit data.
-    Color trace(const Ray& ray, RayKind kind, int depth, RayCounters& counters, PrimaryInfo* primary = nullptr) const;
+    /// `depth`). Never NaN or infinite. `primary` (optional) receives first-hit data. `cone` is the
+    /// ray's footprint for texture filtering; it is carried through reflection and refraction.
+    Color trace(const Ray& ray, RayKind kind, int depth, RayCounters& counters, PrimaryInfo* primary = nullptr,
+                const RayCone& cone = {}) const;
+    /// First-hit data only (no shading, no secondary rays) for a camera ray: AOVs of pixel centres
+    /// in anti-aliasing modes that trace no centre sample. Counted as `aov_probe`.
+    void probe(const Ray& ray, RayCounters& counters, PrimaryInfo& primary) const;
 
     const IntegratorSettings& settings() const { return m_settings; }
 
 private:
-    Color shade(const Ray& ray, const Hit& hit, int depth, RayCounters& counters, PrimaryInfo* primary) const;
+    Color shade(const Ray& ray, const Hit& hit, int depth, RayCounters& counters, PrimaryInfo* primary,
+                const RayCone& cone) const;
 
     const SceneView& m_view;
     const Accelerator& m_accel;

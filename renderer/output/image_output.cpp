@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -220,6 +221,7 @@ void validate_film(const Film& film, const std::string& path) {
     check(film.aovs.albedo, film.albedo.size(), "albedo");
     check(film.aovs.prim_id, film.prim_id.size(), "prim_id");
     check(film.aovs.inst_id, film.inst_id.size(), "inst_id");
+    check(film.aovs.aa_samples, film.aa_samples.size(), "aa_samples");
 }
 
 /// One image ready for OIIO: its spec and pixels in `format` (TypeUnknown = native per-channel).
@@ -258,6 +260,7 @@ EncodedImage encode_exr(const Film& film, const OutputSettings& settings) {
     if (film.aovs.albedo) add({"albedo.R", "albedo.G", "albedo.B"}, OIIO::TypeFloat);
     if (film.aovs.prim_id) add({"primId"}, OIIO::TypeUInt);
     if (film.aovs.inst_id) add({"instId"}, OIIO::TypeUInt);
+    if (film.aovs.aa_samples) add({"aa.samples"}, OIIO::TypeFloat);
 
     spec.nchannels = int(names.size());
     spec.channelnames = names;
@@ -301,6 +304,7 @@ EncodedImage encode_exr(const Film& film, const OutputSettings& settings) {
         }
         if (film.aovs.prim_id) append_bytes(image.bytes, film.prim_id[i]);
         if (film.aovs.inst_id) append_bytes(image.bytes, film.inst_id[i]);
+        if (film.aovs.aa_samples) append_bytes(image.bytes, film.aa_samples[i]);
     }
     RT_CHECK_EQ(image.bytes.size(), n * spec.pixel_bytes(true));
     image.format = OIIO::TypeUnknown;
@@ -361,23 +365,46 @@ EncodedImage encode_display(const Film& film, FileKind kind, const OutputSetting
 }
 
 /// Removes a temporary file when it goes out of scope, unless released (after the rename).
+/// The temporary file of the write in progress as a plain C string, so that a signal handler can
+/// remove it (remove_partial_output()); one write at a time is tracked (the CLI writes one).
+char g_partial_path[4096];
+std::atomic<bool> g_partial_active{false};
+
 class TempFileGuard {
 public:
-    explicit TempFileGuard(fs::path path) : m_path(std::move(path)) {}
+    explicit TempFileGuard(fs::path path) : m_path(std::move(path)) {
+        const std::string& s = m_path.native();
+        bool expected = false;
+        if (s.size() < sizeof(g_partial_path) && g_partial_active.compare_exchange_strong(expected, true)) {
+            // Published before the file exists; unlink of a missing file is harmless.
+            std::memcpy(g_partial_path, s.c_str(), s.size() + 1);
+            m_tracked = true;
+        }
+    }
     ~TempFileGuard() {
         if (m_active) {
             std::error_code ignored;
             fs::remove(m_path, ignored);
         }
+        untrack();
     }
     TempFileGuard(const TempFileGuard&) = delete;
     TempFileGuard& operator=(const TempFileGuard&) = delete;
     const fs::path& path() const { return m_path; }
-    void release() { m_active = false; }
+    void release() {
+        m_active = false;
+        untrack();
+    }
 
 private:
+    void untrack() {
+        if (m_tracked) g_partial_active.store(false);
+        m_tracked = false;
+    }
+
     fs::path m_path;
     bool m_active = true;
+    bool m_tracked = false;  ///< registered in g_partial_path
 };
 
 /// Writes `image` to "<dir>/.<stem>.tmp-<pid><ext>" and renames it to `path`; on any failure
@@ -410,6 +437,12 @@ void write_atomically(const EncodedImage& image, FileKind kind, const fs::path& 
 }
 
 }  // namespace
+
+/// Async-signal-safe (unlink only): removes the temporary file of a write in progress, so a
+/// process ended by a signal leaves no half-written file. Declared where it is used (main.cpp).
+void remove_partial_output() noexcept {
+    if (g_partial_active.load()) ::unlink(g_partial_path);
+}
 
 void write_image(const Film& film, const std::string& path, const OutputSettings& settings) {
     const fs::path file(path);

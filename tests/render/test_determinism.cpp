@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <vector>
 
 #include "renderer/integrator/render.h"
 #include "tests/support/scene_builder.h"
@@ -41,15 +42,16 @@ Scene glass_and_shadows_scene() {
     return s;
 }
 
-Film render(const Scene& s, int threads, int tile) {
+Film render(const Scene& s, int threads, int tile, const AaSettings& aa = {}, RenderStats* stats = nullptr) {
     RenderSettings rs;
     rs.width = 97;  // odd on purpose: no tile size below divides it
     rs.height = 61;
     rs.threads = threads;
     rs.tile_size = tile;
-    rs.aovs = AovSet{true, true, true, true, true};
+    rs.aovs = AovSet{true, true, true, true, true, true};
+    rs.aa = aa;
     Renderer r(s, rs);
-    return r.render();
+    return r.render(stats);
 }
 
 bool bit_identical(const Film& a, const Film& b) {
@@ -57,7 +59,29 @@ bool bit_identical(const Film& a, const Film& b) {
            std::memcmp(a.beauty.data(), b.beauty.data(), a.beauty.size() * sizeof(Color)) == 0 &&
            std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * sizeof(float)) == 0 &&
            std::memcmp(a.normal.data(), b.normal.data(), a.normal.size() * sizeof(Vec3f)) == 0 &&
-           a.prim_id == b.prim_id && a.inst_id == b.inst_id;
+           a.prim_id == b.prim_id && a.inst_id == b.inst_id && a.aa_samples == b.aa_samples;
+}
+
+/// Every anti-aliasing mode, with settings that exercise its sharing across tiles.
+std::vector<AaSettings> all_aa_modes() {
+    std::vector<AaSettings> modes;
+    AaSettings a;
+    a.mode = AaMode::Center;
+    modes.push_back(a);
+    a.mode = AaMode::Corners;
+    modes.push_back(a);
+    a.mode = AaMode::Adaptive;  // the CLI default: threshold 0.1, depth 2
+    modes.push_back(a);
+    a.threshold = -1.f;  // always split: every edge point is shared
+    a.depth = 3;
+    modes.push_back(a);
+    a = AaSettings{};
+    a.mode = AaMode::Stratified;
+    a.spp = 4;
+    modes.push_back(a);
+    a.filter = PixelFilter::Tent;
+    modes.push_back(a);
+    return modes;
 }
 
 TEST(Determinism, ThreadCountAndTileSizeDoNotChangeTheImage) {
@@ -75,6 +99,40 @@ TEST(Determinism, ThreadCountAndTileSizeDoNotChangeTheImage) {
 
     for (auto [threads, tile] : {std::pair{8, 32}, std::pair{2, 7}, std::pair{8, 13}, std::pair{3, 1}, std::pair{8, 200}})
         EXPECT_TRUE(bit_identical(reference, render(s, threads, tile))) << threads << " threads, tile " << tile;
+}
+
+TEST(Determinism, EveryAaModeIsIndependentOfThreadsAndTiles) {
+    const Scene s = glass_and_shadows_scene();
+    for (const AaSettings& aa : all_aa_modes()) {
+        RenderStats ref_stats;
+        const Film reference = render(s, 1, 32, aa, &ref_stats);
+        for (auto [threads, tile] : {std::pair{2, 7}, std::pair{3, 1}, std::pair{8, 200}}) {
+            RenderStats stats;
+            EXPECT_TRUE(bit_identical(reference, render(s, threads, tile, aa, &stats)))
+                << aa_mode_name(aa.mode) << " t=" << aa.threshold << ": " << threads << " threads, tile " << tile;
+            // Shared samples are traced once whatever the tiling: the counts match exactly.
+            EXPECT_EQ(stats.rays.camera, ref_stats.rays.camera) << aa_mode_name(aa.mode) << " tile " << tile;
+            EXPECT_EQ(stats.rays.total(), ref_stats.rays.total()) << aa_mode_name(aa.mode) << " tile " << tile;
+        }
+    }
+}
+
+TEST(Determinism, EveryAaModeCropsToTheSamePixels) {
+    const Scene s = glass_and_shadows_scene();
+    for (const AaSettings& aa : all_aa_modes()) {
+        const Film full = render(s, 2, 16, aa);
+        RenderSettings rs;
+        rs.width = 97;
+        rs.height = 61;
+        rs.threads = 2;
+        rs.tile_size = 9;
+        rs.aa = aa;
+        rs.crop = PixelWindow{10, 5, 60, 40};
+        const Film crop = Renderer(s, rs).render();
+        for (int y = 5; y < 40; ++y)
+            for (int x = 10; x < 60; ++x)
+                ASSERT_EQ(crop.beauty[crop.index(x, y)], full.beauty[full.index(x, y)]) << aa_mode_name(aa.mode);
+    }
 }
 
 TEST(Determinism, CropRendersTheSamePixelsAsTheFullImage) {

@@ -2,12 +2,15 @@
 
 #include <embree3/rtcore.h>
 
+#include <atomic>
 #include <chrono>
+#include <cstring>
 #include <cmath>
 #include <mutex>
 #include <string>
 #include <vector>
 
+#include "renderer/accel/common/geometry.h"
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
 #include "renderer/scene/scene.h"
@@ -15,6 +18,33 @@
 namespace whitted {
 
 namespace {
+
+/// Ceiling on the bytes Embree may hold at once, all devices together (set_embree_memory_limit;
+/// the CLI passes --max-memory, the importer's ceiling). Default: ImportOptions' 8 GiB.
+std::atomic<size_t> g_memory_limit{size_t(8) << 30};
+std::atomic<int64_t> g_memory_used{0};
+
+/// rtcSetDeviceMemoryMonitorFunction callback: refusing an allocation (returning false) makes
+/// Embree fail the build with RTC_ERROR_OUT_OF_MEMORY, reported through the error callback as
+/// a whitted::Error instead of the process being killed. Frees (bytes < 0) always pass.
+bool memory_monitor(void*, ssize_t bytes, bool post) {
+    if (bytes <= 0) {
+        g_memory_used.fetch_add(int64_t(bytes));
+        return true;
+    }
+    const int64_t now = g_memory_used.fetch_add(int64_t(bytes)) + int64_t(bytes);
+    if (!post && now > int64_t(g_memory_limit.load())) {
+        g_memory_used.fetch_sub(int64_t(bytes));  // refused: Embree does not report it freed
+        return false;
+    }
+    return true;
+}
+
+/// Bytes after the last vertex: Embree reads vertices with 16-byte SSE loads, so the 12-byte
+/// FLOAT3 of the last one would otherwise be read 4 bytes past the end (Embree's
+/// rtcSetSharedGeometryBuffer documentation); a read outside the buffer inside Embree is
+/// invisible to AddressSanitizer, so the padding is explicit rather than left to Embree.
+constexpr size_t kVertexPadding = 16;
 
 /// Surfaces remembered per shadow ray to count each crossing once. Beyond this many distinct
 /// crossings de-duplication stops (the product is still taken; documented limit).
@@ -104,6 +134,7 @@ public:
         m_device = rtcNewDevice(device_config.c_str());
         if (!m_device) throw Error(fmt::format("Embree: cannot create device ({})", int(rtcGetDeviceError(nullptr))));
         rtcSetDeviceErrorFunction(m_device, &EmbreeAccelerator::on_error, this);
+        rtcSetDeviceMemoryMonitorFunction(m_device, &memory_monitor, nullptr);
 
         const RTCSceneFlags flags = config.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE;
 
@@ -113,11 +144,23 @@ public:
             const Mesh& mesh = scene.meshes[m];
             if (mesh.triangle_count() == 0) continue;
             RTCGeometry g = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_TRIANGLE);
-            auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                                  3 * sizeof(float), mesh.positions.size()));
+            // Vertex buffer with explicit tail padding (kVertexPadding), zero-filled.
+            const size_t vertex_bytes = mesh.positions.size() * 3 * sizeof(float);
+            RTCBuffer vb = rtcNewBuffer(m_device, vertex_bytes + kVertexPadding);
+            auto* v = vb ? static_cast<float*>(rtcGetBufferData(vb)) : nullptr;
+            if (v) {
+                std::memset(reinterpret_cast<char*>(v) + vertex_bytes, 0, kVertexPadding);
+                rtcSetGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, vb, 0, 3 * sizeof(float),
+                                     mesh.positions.size());
+            }
+            if (vb) rtcReleaseBuffer(vb);  // the geometry holds its own reference
             auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                                        3 * sizeof(uint32_t), mesh.triangle_count()));
-            if (!v || !idx) throw_pending("allocating geometry buffers");
+            if (!v || !idx) {
+                rtcReleaseGeometry(g);
+                throw_pending("allocating geometry buffers");
+                throw Error("Embree: cannot allocate geometry buffers");
+            }
             for (size_t i = 0; i < mesh.positions.size(); ++i) {
                 v[3 * i + 0] = mesh.positions[i].x;
                 v[3 * i + 1] = mesh.positions[i].y;
@@ -172,6 +215,7 @@ public:
     }
 
     Hit intersect(const Ray& ray, RayKind kind) const override {
+        if (!ray_is_traceable(ray)) return Hit{};  // NaN/zero-direction rays: Embree asserts on them
         QueryContext q;
         rtcInitIntersectContext(&q.rtc);
         q.filter = &m_filter;
@@ -195,6 +239,7 @@ public:
     }
 
     Color transmittance(const Ray& ray) const override {
+        if (!ray_is_traceable(ray)) return Color(1.f);
         QueryContext q;
         rtcInitIntersectContext(&q.rtc);
         q.filter = &m_filter;
@@ -230,7 +275,11 @@ private:
     static void on_error(void* user, RTCError code, const char* message) {
         auto* self = static_cast<EmbreeAccelerator*>(user);
         std::lock_guard lock(self->m_error_mutex);
-        if (self->m_error.empty()) self->m_error = fmt::format("Embree error {}: {}", int(code), message ? message : "");
+        if (!self->m_error.empty()) return;
+        self->m_error = fmt::format("Embree error {}: {}", int(code), message ? message : "");
+        if (code == RTC_ERROR_OUT_OF_MEMORY)
+            self->m_error +=
+                fmt::format(" (Embree's memory ceiling is {} MiB: --max-memory)", g_memory_limit.load() >> 20);
     }
 
     void throw_pending(const char* what) {
@@ -250,6 +299,8 @@ private:
 };
 
 }  // namespace
+
+void set_embree_memory_limit(size_t bytes) { g_memory_limit.store(bytes); }
 
 std::unique_ptr<Accelerator> create_embree_accelerator(const Scene& scene, const SurfaceFilter& filter,
                                                        const EmbreeConfig& config) {

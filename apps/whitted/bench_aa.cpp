@@ -1,0 +1,381 @@
+// `whitted bench aa SCENE...`: run time against error for every anti-aliasing mode.
+//
+// For each scene: a converged box-filtered reference (stratified, --ref-spp samples per pixel,
+// cached on disk by a hash of the scene files and the settings), then every mode over a sweep of
+// settings on the same accelerator. Each run reports wall time (the minimum of --repeat runs),
+// primary and total rays, RMSE / PSNR / relative MSE against the reference in linear and in
+// display-referred values (the OCIO "Standard" view, clamped to [0, 1]) and the fraction of
+// pixels adaptive sampling subdivided. Writes <out>/aa.csv, per scene the reference image and an
+// adaptive sample-density heat map, and (when python3 with matplotlib is available) the
+// error-against-time plots through scripts/plot_aa.py. See docs/antialiasing.md.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "apps/whitted/command.h"
+#include "importers/scene_loader.h"
+#include "renderer/core/error.h"
+#include "renderer/core/log.h"
+#include "renderer/integrator/render.h"
+#include "renderer/output/image_output.h"
+
+namespace whitted::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Bumped whenever a renderer change invalidates cached references.
+constexpr const char* kReferenceVersion = "aa-reference-v1";
+
+struct BenchAaOptions {
+    std::vector<std::string> scenes;
+    int width = 160;                 ///< image width in pixels (height from the camera aspect)
+    int ref_spp = 256;               ///< reference samples per pixel (k*k, box filter)
+    int repeat = 3;                  ///< timed runs per setting (fewer once a setting has taken 2 s); the minimum is reported
+    int threads = 0;                 ///< 0 = all cores
+    int max_depth = 5;               ///< ray-tree depth
+    std::string out = "bench-aa";    ///< output directory (CSV, images, plots)
+    std::string cache;               ///< reference cache directory; empty = $XDG_CACHE_HOME/whitted or ~/.cache/whitted
+    bool quick = false;              ///< a shorter sweep
+    bool plot = true;                ///< run scripts/plot_aa.py afterwards when possible
+    std::string python = "python3";  ///< interpreter with matplotlib for the plots
+};
+
+/// One benchmark run: the settings and what they measured.
+struct Run {
+    std::string scene;
+    AaSettings aa;
+    double seconds = 0.0;
+    RenderStats stats;
+    double rmse_lin = 0, psnr_lin = 0, relmse_lin = 0, rmse_disp = 0, psnr_disp = 0, relmse_disp = 0;
+    bool pareto = false;
+};
+
+/// FNV-1a 64 over bytes.
+uint64_t fnv1a(uint64_t h, const void* data, size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
+    return h;
+}
+
+/// Hash of the scene's files: a .glb alone; a .gltf with every file of its directory (buffers and
+/// images live next to it), in sorted order so the hash does not depend on directory order.
+uint64_t hash_scene_files(const fs::path& scene) {
+    std::vector<fs::path> files{scene};
+    if (scene.extension() != ".glb") {
+        files.clear();
+        for (const auto& e : fs::directory_iterator(scene.parent_path().empty() ? fs::path(".") : scene.parent_path()))
+            if (e.is_regular_file()) files.push_back(e.path());
+        std::sort(files.begin(), files.end());
+    }
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (const fs::path& f : files) {
+        std::ifstream in(f, std::ios::binary);
+        std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        const std::string name = f.filename().string();
+        h = fnv1a(h, name.data(), name.size());
+        h = fnv1a(h, bytes.data(), bytes.size());
+    }
+    return h;
+}
+
+fs::path default_cache_dir() {
+    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && xdg[0]) return fs::path(xdg) / "whitted";
+    if (const char* home = std::getenv("HOME"); home && home[0]) return fs::path(home) / ".cache" / "whitted";
+    return fs::temp_directory_path() / "whitted-cache";
+}
+
+std::string scene_label(const fs::path& p) { return p.stem().string(); }
+
+/// Error metrics of `img` against `ref` (packed RGB): RMSE, PSNR (peak 1) and relative MSE
+/// (mean of (a - b)^2 / (b^2 + 0.01), per channel).
+void metrics(const std::vector<float>& img, const std::vector<float>& ref, double& rmse, double& psnr, double& relmse) {
+    double se = 0.0, rel = 0.0;
+    for (size_t i = 0; i < ref.size(); ++i) {
+        const double d = double(img[i]) - double(ref[i]);
+        se += d * d;
+        rel += d * d / (double(ref[i]) * double(ref[i]) + 0.01);
+    }
+    const double mse = se / double(ref.size());
+    rmse = std::sqrt(mse);
+    psnr = mse > 0 ? 10.0 * std::log10(1.0 / mse) : 999.0;
+    relmse = rel / double(ref.size());
+}
+
+std::vector<float> packed(const Film& film) {
+    std::vector<float> rgb(film.beauty.size() * 3);
+    for (size_t i = 0; i < film.beauty.size(); ++i)
+        for (int c = 0; c < 3; ++c) rgb[3 * i + size_t(c)] = film.beauty[i][c];
+    return rgb;
+}
+
+/// Display-referred values: the OCIO transform, NaN -> 0, clamped to [0, 1] (what a PNG stores).
+std::vector<float> to_display(std::vector<float> rgb, const DisplayTransform& display) {
+    display.apply(rgb.data(), rgb.size() / 3);
+    for (float& v : rgb) v = std::isnan(v) ? 0.f : std::clamp(v, 0.f, 1.f);
+    return rgb;
+}
+
+/// A perceptually ordered colour map (viridis, 9 control points, linearly interpolated), display values.
+Color viridis(float t) {
+    static const float k[9][3] = {{0.267f, 0.005f, 0.329f}, {0.282f, 0.141f, 0.458f}, {0.254f, 0.265f, 0.530f},
+                                  {0.207f, 0.372f, 0.553f}, {0.164f, 0.471f, 0.558f}, {0.128f, 0.567f, 0.551f},
+                                  {0.135f, 0.659f, 0.518f}, {0.478f, 0.821f, 0.318f}, {0.993f, 0.906f, 0.144f}};
+    t = std::clamp(t, 0.f, 1.f) * 8.f;
+    const int i = std::min(int(t), 7);
+    const float f = t - float(i);
+    return {k[i][0] + (k[i + 1][0] - k[i][0]) * f, k[i][1] + (k[i + 1][1] - k[i][1]) * f,
+            k[i][2] + (k[i + 1][2] - k[i][2]) * f};
+}
+
+/// Writes the aa_samples AOV as a heat map PNG (log scale from 4 to (2^depth + 1)^2 samples).
+void write_heat_map(const Film& film, int depth, const fs::path& path) {
+    Film heat(film.full_width, film.full_height, film.window, AovSet{});
+    const double lo = std::log(4.0), hi = std::log(std::pow(double((1 << depth) + 1), 2.0));
+    for (size_t i = 0; i < film.aa_samples.size(); ++i) {
+        const double s = std::max(1.0, double(film.aa_samples[i]));
+        heat.beauty[i] = viridis(float((std::log(s) - lo) / (hi - lo)));
+    }
+    OutputSettings os;
+    os.color.view = "Raw";  // the colour map is already display-referred
+    write_image(heat, path.string(), os);
+}
+
+std::string describe(const AaSettings& aa) {
+    switch (aa.mode) {
+        case AaMode::Center:
+        case AaMode::Corners: return aa_mode_name(aa.mode);
+        case AaMode::Adaptive: return fmt::format("adaptive t={:g} d={}", aa.threshold, aa.depth);
+        case AaMode::Stratified: return fmt::format("stratified {} spp {}", aa.spp, pixel_filter_name(aa.filter));
+    }
+    return "?";
+}
+
+/// The settings swept for every scene.
+std::vector<AaSettings> sweep(bool quick) {
+    std::vector<AaSettings> s;
+    auto add = [&](AaMode mode, float threshold, int depth, int spp, PixelFilter filter) {
+        AaSettings a;
+        a.mode = mode;
+        a.threshold = threshold;
+        a.depth = depth;
+        a.spp = spp;
+        a.filter = filter;
+        s.push_back(a);
+    };
+    add(AaMode::Center, 0, 0, 1, PixelFilter::Box);
+    add(AaMode::Corners, 0, 0, 1, PixelFilter::Box);
+    const std::vector<int> depths = quick ? std::vector<int>{3} : std::vector<int>{1, 2, 3};
+    const std::vector<float> thresholds =
+        quick ? std::vector<float>{0.2f, 0.1f, 0.05f} : std::vector<float>{0.4f, 0.2f, 0.1f, 0.05f, 0.025f, 0.0125f};
+    for (int d : depths)
+        for (float t : thresholds) add(AaMode::Adaptive, t, d, 1, PixelFilter::Box);
+    const std::vector<int> spps = quick ? std::vector<int>{4, 16, 64} : std::vector<int>{1, 4, 9, 16, 36, 64};
+    for (int n : spps) add(AaMode::Stratified, 0, 0, n, PixelFilter::Box);
+    for (int n : quick ? std::vector<int>{16} : std::vector<int>{4, 16, 64}) add(AaMode::Stratified, 0, 0, n, PixelFilter::Tent);
+    return s;
+}
+
+/// Marks the runs no other run beats in both time and display RMSE.
+void mark_pareto(std::vector<Run>& runs) {
+    for (Run& r : runs) {
+        r.pareto = std::none_of(runs.begin(), runs.end(), [&](const Run& o) {
+            return &o != &r && o.seconds <= r.seconds && o.rmse_disp <= r.rmse_disp &&
+                   (o.seconds < r.seconds || o.rmse_disp < r.rmse_disp);
+        });
+    }
+}
+
+int run_bench_aa(const BenchAaOptions& o) {
+    if (o.scenes.empty()) throw Error("bench aa: give at least one scene");
+    if (stratified_side(o.ref_spp) == 0) throw Error(fmt::format("--ref-spp must be a square number (got {})", o.ref_spp));
+    const fs::path out(o.out);
+    fs::create_directories(out);
+    const fs::path cache = (o.cache.empty() ? default_cache_dir() : fs::path(o.cache)) / "aa-references";
+    fs::create_directories(cache);
+    const DisplayTransform display(ColorSettings{});
+
+    std::ofstream csv(out / "aa.csv");
+    csv << "scene,mode,filter,threshold,depth,spp,label,seconds,camera_rays,total_rays,camera_rays_per_pixel,"
+           "rmse_linear,psnr_linear,relmse_linear,rmse_display,psnr_display,relmse_display,subdivided_fraction,"
+           "pareto\n";
+
+    for (const std::string& scene_path : o.scenes) {
+        const std::string label = scene_label(scene_path);
+        Scene scene = load_scene(scene_path);
+        RenderSettings rs;
+        rs.width = o.width;
+        rs.threads = o.threads;
+        rs.integrator.max_depth = o.max_depth;
+        Renderer renderer(scene, rs);
+        const ImageSize size = renderer.image_size();
+        std::printf("== %s: %dx%d, %zu triangles, build %.3fs\n", label.c_str(), size.width, size.height,
+                    scene.instanced_triangle_count(), renderer.build_seconds());
+
+        // Reference: cached by scene files + settings (+ renderer version tag).
+        const std::string key_text = fmt::format("{}|{}|{}x{}|spp={}|box|depth={}|{}", kReferenceVersion, WHITTED_VERSION,
+                                                 size.width, size.height, o.ref_spp, o.max_depth, label);
+        const uint64_t key = fnv1a(hash_scene_files(scene_path), key_text.data(), key_text.size());
+        const fs::path ref_path = cache / fmt::format("{}-{:016x}.exr", label, key);
+        std::vector<float> ref;
+        if (fs::exists(ref_path)) {
+            int w = 0, h = 0;
+            ref = read_image_rgb(ref_path.string(), w, h);
+            if (w != size.width || h != size.height) ref.clear();
+            else std::printf("   reference: cached %s\n", ref_path.c_str());
+        }
+        if (ref.empty()) {
+            AaSettings ra;
+            ra.mode = AaMode::Stratified;
+            ra.spp = o.ref_spp;
+            RenderStats st;
+            Film film = renderer.render(ra, &st);
+            OutputSettings os;
+            os.exr_half = false;
+            write_image(film, ref_path.string(), os);
+            ref = packed(film);
+            std::printf("   reference: %d spp in %.2fs -> %s\n", o.ref_spp, st.render_seconds, ref_path.c_str());
+        }
+        {
+            Film ref_film(size.width, size.height, PixelWindow{0, 0, size.width, size.height}, AovSet{});
+            for (size_t i = 0; i < ref_film.beauty.size(); ++i) ref_film.beauty[i] = {ref[3 * i], ref[3 * i + 1], ref[3 * i + 2]};
+            write_image(ref_film, (out / (label + "-reference.png")).string(), OutputSettings{});
+        }
+        const std::vector<float> ref_disp = to_display(ref, display);
+
+        std::vector<Run> runs;
+        for (const AaSettings& aa : sweep(o.quick)) {
+            Run r;
+            r.scene = label;
+            r.aa = aa;
+            r.seconds = 1e30;
+            Film film;
+            double spent = 0.0;
+            for (int i = 0; i < std::max(1, o.repeat) && spent < 2.0; ++i) {
+                RenderStats st;
+                film = renderer.render(aa, &st);
+                spent += st.render_seconds;
+                if (st.render_seconds < r.seconds) {
+                    r.seconds = st.render_seconds;
+                    r.stats = st;
+                }
+            }
+            const std::vector<float> img = packed(film);
+            metrics(img, ref, r.rmse_lin, r.psnr_lin, r.relmse_lin);
+            metrics(to_display(img, display), ref_disp, r.rmse_disp, r.psnr_disp, r.relmse_disp);
+            runs.push_back(r);
+        }
+        mark_pareto(runs);
+
+        std::printf("   %-28s %9s %10s %8s %10s %10s %8s %6s\n", "setting", "time[s]", "cam rays", "rays/px",
+                    "rmse lin", "rmse disp", "psnr", "split");
+        const double pixels = double(size.width) * double(size.height);
+        for (const Run& r : runs) {
+            const double split = r.stats.pixels ? double(r.stats.pixels_subdivided) / double(r.stats.pixels) : 0.0;
+            std::printf("   %-28s %9.4f %10llu %8.2f %10.5f %10.5f %8.2f %5.1f%%%s\n", describe(r.aa).c_str(), r.seconds,
+                        (unsigned long long)r.stats.rays.camera, double(r.stats.rays.camera) / pixels, r.rmse_lin,
+                        r.rmse_disp, r.psnr_disp, 100.0 * split, r.pareto ? "  *" : "");
+            csv << fmt::format("{},{},{},{:g},{},{},\"{}\",{:.6f},{},{},{:.4f},{:.6g},{:.4f},{:.6g},{:.6g},{:.4f},{:.6g},{:.5f},{}\n",
+                               label, aa_mode_name(r.aa.mode), pixel_filter_name(r.aa.filter),
+                               r.aa.mode == AaMode::Adaptive ? r.aa.threshold : 0.f,
+                               r.aa.mode == AaMode::Adaptive ? r.aa.depth : 0,
+                               r.aa.mode == AaMode::Stratified ? r.aa.spp : (r.aa.mode == AaMode::Center ? 1 : 0),
+                               describe(r.aa), r.seconds, r.stats.rays.camera, r.stats.rays.total(),
+                               double(r.stats.rays.camera) / pixels, r.rmse_lin, r.psnr_lin, r.relmse_lin, r.rmse_disp,
+                               r.psnr_disp, r.relmse_disp, split, r.pareto ? 1 : 0);
+        }
+        csv.flush();
+
+        // Targets (docs/antialiasing.md): adaptive against stratified 16 spp, corners against center.
+        auto find = [&](AaMode mode, int spp) -> const Run* {
+            for (const Run& r : runs)
+                if (r.aa.mode == mode && (mode != AaMode::Stratified || (r.aa.spp == spp && r.aa.filter == PixelFilter::Box)))
+                    return &r;
+            return nullptr;
+        };
+        const Run* s16 = find(AaMode::Stratified, 16);
+        const Run* center = find(AaMode::Center, 1);
+        const Run* corners = find(AaMode::Corners, 1);
+        if (s16) {
+            const Run* best = nullptr;
+            for (const Run& r : runs)
+                if (r.aa.mode == AaMode::Adaptive && r.rmse_disp <= s16->rmse_disp && (!best || r.seconds < best->seconds)) best = &r;
+            // Also by total rays traced: a cost that does not depend on the machine's load.
+            const Run* fewest = nullptr;
+            for (const Run& r : runs)
+                if (r.aa.mode == AaMode::Adaptive && r.rmse_disp <= s16->rmse_disp &&
+                    (!fewest || r.stats.rays.total() < fewest->stats.rays.total()))
+                    fewest = &r;
+            if (best)
+                std::printf("   target adaptive <= 1/3 time of stratified 16 at its display RMSE %.5f: %s at %.3fx time -> %s;"
+                            " by total rays %s at %.3fx\n",
+                            s16->rmse_disp, describe(best->aa).c_str(), best->seconds / s16->seconds,
+                            best->seconds <= s16->seconds / 3.0 ? "MET" : "NOT MET", describe(fewest->aa).c_str(),
+                            double(fewest->stats.rays.total()) / double(s16->stats.rays.total()));
+            else
+                std::printf("   target adaptive <= 1/3 time of stratified 16 at its display RMSE %.5f: no adaptive setting "
+                            "reaches it -> NOT MET\n", s16->rmse_disp);
+        }
+        if (center && corners)
+            std::printf("   target corners <= 1.1x center time: %.3fx -> %s (display RMSE center %.5f, corners %.5f)\n",
+                        corners->seconds / center->seconds, corners->seconds <= 1.1 * center->seconds ? "MET" : "NOT MET",
+                        center->rmse_disp, corners->rmse_disp);
+
+        // Sample-density heat map of the default adaptive setting, and that image.
+        AaSettings def;
+        def.mode = AaMode::Adaptive;
+        RenderSettings hs = rs;
+        hs.aovs.aa_samples = true;
+        hs.aa = def;
+        Renderer heat_renderer(scene, hs);
+        const Film heat = heat_renderer.render();
+        write_heat_map(heat, def.depth, out / (label + "-adaptive-samples.png"));
+        write_image(heat, (out / (label + "-adaptive.png")).string(), OutputSettings{});
+        Film center_film = renderer.render(AaSettings{});
+        write_image(center_film, (out / (label + "-center.png")).string(), OutputSettings{});
+    }
+    std::printf("wrote %s\n", (out / "aa.csv").c_str());
+
+    if (o.plot) {
+        const fs::path script = fs::path(WHITTED_SOURCE_DIR) / "scripts" / "plot_aa.py";
+        const std::string cmd = fmt::format("{} '{}' '{}' '{}'", o.python, script.string(), (out / "aa.csv").string(), out.string());
+        if (fs::exists(script) && std::system((o.python + " -c 'import matplotlib' >/dev/null 2>&1").c_str()) == 0) {
+            if (std::system(cmd.c_str()) != 0) log_warning("bench aa: plotting failed: {}", cmd);
+        } else {
+            log_warning("bench aa: python3 with matplotlib not found; plot later with: {}", cmd);
+        }
+    }
+    return 0;
+}
+
+}  // namespace
+
+Command register_bench_aa(CLI::App& bench) {
+    auto o = std::make_shared<BenchAaOptions>();
+    CLI::App* app = bench.add_subcommand("aa", "Anti-aliasing: error against run time for every mode (docs/antialiasing.md)");
+    app->add_option("scenes", o->scenes, "Scene files (.gltf or .glb)")->required();
+    app->add_option("--width", o->width, "Image width (height from the camera aspect)")->check(CLI::Range(8, 4096))
+        ->capture_default_str();
+    app->add_option("--ref-spp", o->ref_spp, "Reference samples per pixel (a square number, box filter)")
+        ->check(CLI::Range(1, 4096))->capture_default_str();
+    app->add_option("--repeat", o->repeat, "Timed runs per setting (the minimum is reported)")->check(CLI::Range(1, 100))
+        ->capture_default_str();
+    app->add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 1024))->capture_default_str();
+    app->add_option("--max-depth", o->max_depth, "Maximum depth of the ray tree")->check(CLI::Range(0, 64))->capture_default_str();
+    app->add_option("--out", o->out, "Output directory: aa.csv, reference/adaptive/heat-map PNGs, plots")->capture_default_str();
+    app->add_option("--cache", o->cache, "Reference cache directory (default $XDG_CACHE_HOME/whitted or ~/.cache/whitted)");
+    app->add_flag("--quick", o->quick, "A shorter sweep");
+    app->add_flag("!--no-plot", o->plot, "Do not run scripts/plot_aa.py");
+    app->add_option("--python", o->python, "Python interpreter with matplotlib for the plots")->capture_default_str();
+    return Command{app, [o] { return run_bench_aa(*o); }};
+}
+
+}  // namespace whitted::app

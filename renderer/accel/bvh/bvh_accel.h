@@ -1,0 +1,52 @@
+// In-house backends built on the binary BVH of bvh_tree.h: `bvh` (box or sphere nodes, float or
+// double precision), `kdop` (Kay-Kajiya 7-slab nodes) and `brute` (no structure: the oracle).
+#pragma once
+
+#include <memory>
+
+#include "renderer/accel/accelerator.h"
+#include "renderer/accel/bvh/bvh_tree.h"
+
+namespace whitted {
+
+/// Scalar type the in-house traversal computes in.
+enum class Precision : uint8_t {
+    Float,   ///< as fast as it gets; the path that is compared with Embree
+    Double,  ///< reference: vertices, transforms, ray and triangle test in double
+};
+
+/// Bounding volume of BVH nodes.
+enum class BoundingVolume : uint8_t {
+    Aabb,    ///< axis-aligned box, conservative slab test (Ize 2013)
+    Sphere,  ///< bounding sphere around the box centre holding all the subtree's vertices
+};
+
+/// Settings of the `bvh` backend.
+struct BvhConfig {
+    BvhBuildConfig build;                        ///< binned SAH settings (bvh_tree.h)
+    BoundingVolume volume = BoundingVolume::Aabb;///< node test (`--bv aabb|sphere`)
+    Precision precision = Precision::Float;      ///< `--precision float|double`
+};
+
+/// Settings of the `kdop` backend: the same SAH topology, nodes bounded by 7-slab k-DOPs fitted
+/// to the triangles below them.
+struct KdopConfig {
+    BvhBuildConfig build;                        ///< binned SAH settings for the topology
+};
+
+/// Settings of the `brute` oracle.
+struct BruteForceConfig {
+    Precision precision = Precision::Float;      ///< double = ground truth for float error
+};
+
+/// Two-level SAH BVH (BLAS per mesh, TLAS over instances), watertight triangle test.
+std::unique_ptr<Accelerator> create_bvh_accelerator(const Scene& scene, const SurfaceFilter& filter,
+                                                    const BvhConfig& config);
+/// Two-level BVH whose nodes are k-DOPs (Kay & Kajiya 1986).
+std::unique_ptr<Accelerator> create_kdop_accelerator(const Scene& scene, const SurfaceFilter& filter,
+                                                     const KdopConfig& config);
+/// Tests every triangle of every instance: O(n) per ray, the oracle the others are checked against.
+std::unique_ptr<Accelerator> create_brute_force_accelerator(const Scene& scene, const SurfaceFilter& filter,
+                                                            const BruteForceConfig& config);
+
+}  // namespace whitted

@@ -1,0 +1,216 @@
+// Two-level acceleration shared by the in-house backends, mirroring the Embree backend's layout:
+// one bottom-level structure (BLAS) per mesh in object space, and a top level over the instances
+// that transforms the ray into each instance's object space (t is unchanged by an affine map of
+// origin and direction). The top level is a SAH BVH over the instances' world boxes, or, for the
+// brute-force oracle, a plain loop.
+//
+// A BLAS type provides
+//   template <class Query> bool traverse(const Vec3<T>& org, const Vec3<T>& dir, T tnear, Query& q) const;
+//     reports every candidate triangle hit in (tnear, q.tmax] to q.report(t, u, v, prim) and
+//     returns true as soon as report() does;
+//   Bounds3<T> bounds() const; BlasStats stats() const.
+#pragma once
+
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "renderer/accel/accelerator.h"
+#include "renderer/accel/bvh/bvh_tree.h"
+#include "renderer/accel/common/geometry.h"
+#include "renderer/accel/common/queries.h"
+#include "renderer/scene/scene.h"
+
+namespace whitted {
+
+/// Size figures of one bottom-level structure.
+struct BlasStats {
+    size_t bytes = 0;
+    size_t nodes = 0;        ///< nodes, cells or voxels
+    size_t references = 0;   ///< primitive references (> triangles when cells duplicate them)
+    double sah_cost = 0.0;   ///< SAH cost of the tree (0 when it does not apply), area-weighted by triangles
+};
+
+/// A triangle's three vertices in the precision T.
+template <typename T>
+struct TriangleVerts {
+    Vec3<T> p0, p1, p2;
+};
+
+/// Object-space triangles of a mesh (index order), degenerate index ranges already validated by
+/// the importer.
+template <typename T>
+std::vector<TriangleVerts<T>> mesh_triangles(const Mesh& mesh) {
+    std::vector<TriangleVerts<T>> tris(mesh.triangle_count());
+    for (size_t i = 0; i < tris.size(); ++i) {
+        tris[i] = {Vec3<T>(mesh.positions[mesh.indices[3 * i]]), Vec3<T>(mesh.positions[mesh.indices[3 * i + 1]]),
+                   Vec3<T>(mesh.positions[mesh.indices[3 * i + 2]])};
+    }
+    return tris;
+}
+
+template <typename T>
+Bounds3<T> triangle_bounds(const TriangleVerts<T>& t) {
+    Bounds3<T> b;
+    b.extend(t.p0);
+    b.extend(t.p1);
+    b.extend(t.p2);
+    return b;
+}
+
+/// Row-major 3x4 affine transform in precision T.
+template <typename T>
+struct Affine {
+    T m[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    bool identity = true;
+    explicit Affine(const Mat4d& x = Mat4d::identity()) {
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 4; ++c) m[r * 4 + c] = T(x(r, c));
+        identity = x == Mat4d::identity();
+    }
+    Vec3<T> point(const Vec3<T>& p) const {
+        return {m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+                m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]};
+    }
+    Vec3<T> vector(const Vec3<T>& v) const {
+        return {m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
+                m[8] * v.x + m[9] * v.y + m[10] * v.z};
+    }
+};
+
+/// The accelerator built from one BLAS per mesh and a top level over instances.
+template <typename T, typename Blas>
+class TwoLevelAccelerator final : public Accelerator {
+public:
+    using BlasBuilder = std::function<Blas(const Mesh&)>;
+
+    /// Builds the BLASes in parallel over meshes (each build is deterministic), then the top
+    /// level. `bvh_top` false = loop over all instances (the brute-force oracle).
+    TwoLevelAccelerator(std::string name, const Scene& scene, const SurfaceFilter& filter, const BlasBuilder& build_blas,
+                        bool bvh_top)
+        : m_name(std::move(name)), m_filter(filter), m_bvh_top(bvh_top) {
+        const auto start = std::chrono::steady_clock::now();
+        // Bottom level: one structure per mesh that has triangles.
+        m_blas.resize(scene.meshes.size());
+        tbb::parallel_for(size_t(0), scene.meshes.size(), [&](size_t m) {
+            if (scene.meshes[m].triangle_count() > 0) m_blas[m] = std::make_unique<Blas>(build_blas(scene.meshes[m]));
+        });
+        // Instances with their inverse transforms and world boxes.
+        std::vector<Bounds3<T>> boxes;
+        for (size_t i = 0; i < scene.instances.size(); ++i) {
+            const Instance& inst = scene.instances[i];
+            if (!m_blas[inst.mesh]) continue;
+            InstanceData d{Affine<T>(inst.world_from_object.inverse_affine()), inst.mesh, uint32_t(i),
+                           filter.mesh_flags(inst.mesh)};
+            d.object_from_world.identity = inst.world_from_object == Mat4d::identity();
+            m_instances.push_back(d);
+            boxes.push_back(world_box(m_blas[inst.mesh]->bounds(), inst.world_from_object));
+        }
+        if (m_bvh_top) {
+            BvhBuildConfig top;
+            top.max_leaf_size = 1;
+            std::vector<BuildNode<T>> built = build_bvh(boxes, top, m_top_ids);
+            m_top.reserve(built.size());
+            for (const BuildNode<T>& n : built) m_top.push_back({AabbVolume<T>{n.box.lo, n.box.hi}, n.index, n.count});
+        }
+        m_stats.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        // Size figures: the BLASes, the top level and the per-instance data.
+        double sah_weighted = 0.0;
+        size_t tris = 0;
+        for (size_t m = 0; m < m_blas.size(); ++m) {
+            if (!m_blas[m]) continue;
+            const BlasStats s = m_blas[m]->stats();
+            m_stats.bytes += s.bytes;
+            m_stats.nodes += s.nodes;
+            m_stats.references += s.references;
+            sah_weighted += s.sah_cost * double(scene.meshes[m].triangle_count());
+            tris += scene.meshes[m].triangle_count();
+        }
+        m_stats.sah_cost = tris ? sah_weighted / double(tris) : 0.0;
+        m_stats.bytes += m_top.size() * sizeof(m_top[0]) + m_top_ids.size() * 4 + m_instances.size() * sizeof(InstanceData);
+        m_stats.nodes += m_top.size();
+    }
+
+    Hit intersect(const Ray& ray, RayKind kind) const override {
+        ClosestQuery<T> q(m_filter, ray, kind);
+        trace(ray, q);
+        return q.best;
+    }
+
+    Color transmittance(const Ray& ray) const override {
+        thread_local std::vector<Crossing> scratch;
+        ShadowQuery<T> q(m_filter, ray, scratch);
+        trace(ray, q);
+        return q.resolve();
+    }
+
+    std::string name() const override { return m_name; }
+    AccelStats stats() const override { return m_stats; }
+
+private:
+    struct InstanceData {
+        Affine<T> object_from_world;
+        uint32_t mesh;
+        uint32_t inst;
+        uint32_t flags;
+    };
+
+    /// World box of an object box under a transform (corners in double, rounded outwards).
+    static Bounds3<T> world_box(const Bounds3<T>& object, const Mat4d& world_from_object) {
+        Bounds3d b;
+        for (int c = 0; c < 8; ++c) {
+            const Vec3d p{double((c & 1) ? object.hi.x : object.lo.x), double((c & 2) ? object.hi.y : object.lo.y),
+                          double((c & 4) ? object.hi.z : object.lo.z)};
+            b.extend(world_from_object.apply_point(p));
+        }
+        Bounds3<T> out;
+        for (int k = 0; k < 3; ++k) {
+            T lo = T(b.lo[k]), hi = T(b.hi[k]);
+            if (double(lo) > b.lo[k]) lo = std::nextafter(lo, -std::numeric_limits<T>::infinity());
+            if (double(hi) < b.hi[k]) hi = std::nextafter(hi, std::numeric_limits<T>::infinity());
+            out.lo[k] = lo;
+            out.hi[k] = hi;
+        }
+        return out;
+    }
+
+    template <class Query>
+    void trace(const Ray& ray, Query& q) const {
+        if (!ray_is_traceable(ray)) return;
+        const Vec3<T> org(ray.org), dir(ray.dir);
+        const T tnear = T(ray.tnear);
+        // Enter one instance: object-space ray, then its BLAS.
+        auto visit = [&](const InstanceData& d) -> bool {
+            q.ctx = InstanceContext{d.mesh, d.inst, d.flags};
+            const Blas& blas = *m_blas[d.mesh];
+            if (d.object_from_world.identity) return blas.traverse(org, dir, tnear, q);
+            return blas.traverse(d.object_from_world.point(org), d.object_from_world.vector(dir), tnear, q);
+        };
+        if (!m_bvh_top) {
+            for (const InstanceData& d : m_instances)
+                if (visit(d)) return;
+            return;
+        }
+        const SlabRay<T> slab(org, dir);
+        traverse_bvh(m_top, slab, tnear, q.tmax, [&](uint32_t first, uint32_t count) {
+            for (uint32_t k = 0; k < count; ++k)
+                if (visit(m_instances[m_top_ids[first + k]])) return true;
+            return false;
+        });
+    }
+
+    std::string m_name;
+    const SurfaceFilter& m_filter;
+    bool m_bvh_top = true;
+    std::vector<std::unique_ptr<Blas>> m_blas;
+    std::vector<InstanceData> m_instances;
+    std::vector<BvhNode<AabbVolume<T>>> m_top;
+    std::vector<uint32_t> m_top_ids;
+    AccelStats m_stats;
+};
+
+}  // namespace whitted

@@ -1,0 +1,180 @@
+#include "renderer/accel/grid/grid_accel.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "renderer/accel/common/mailbox.h"
+#include "renderer/accel/common/two_level.h"
+
+namespace whitted {
+
+namespace {
+
+/// A uniform grid over one mesh: cell c holds m_refs[m_start[c], m_start[c + 1]) (triangle
+/// indices, ascending), cells ordered x fastest.
+class TriangleGrid {
+public:
+    TriangleGrid(const Mesh& mesh, const GridConfig& config) : m_tris(mesh_triangles<float>(mesh)) {
+        for (const auto& t : m_tris) m_bounds.extend(triangle_bounds(t));
+        choose_resolution(config);
+        bin_triangles();
+    }
+
+    template <class Query>
+    bool traverse(const Vec3f& org, const Vec3f& dir, float tnear, Query& q) const {
+        // Clip the ray to the grid box.
+        const SlabRay<float> slab(org, dir);
+        const float t_enter = slab_entry(slab, Vec3f(m_lo[0], m_lo[1], m_lo[2]), Vec3f(m_hi[0], m_hi[1], m_hi[2]), tnear, q.tmax);
+        if (t_enter == kInfinity) return false;
+        float t_exit = q.tmax * kRayTmaxScale<float>;
+        for (int a = 0; a < 3; ++a) {
+            const float t_far = ((slab.neg[a] ? m_lo[a] : m_hi[a]) - org[a]) * slab.inv_dir[a] * kSlabExitScale<float>;
+            t_exit = t_far < t_exit ? t_far : t_exit;
+        }
+
+        // DDA set-up: the entry cell, the t of the next boundary and the t step per axis.
+        const Vec3f entry = org + dir * t_enter;
+        int cell[3], step[3], out[3];
+        float next[3], delta[3];
+        for (int a = 0; a < 3; ++a) {
+            cell[a] = std::clamp(int((entry[a] - m_lo[a]) * m_inv_cell[a]), 0, m_res[a] - 1);
+            if (dir[a] > 0.f) {
+                step[a] = 1;
+                out[a] = m_res[a];
+                next[a] = (m_lo[a] + float(cell[a] + 1) * m_cell[a] - org[a]) / dir[a];
+                delta[a] = m_cell[a] / dir[a];
+            } else if (dir[a] < 0.f) {
+                step[a] = -1;
+                out[a] = -1;
+                next[a] = (m_lo[a] + float(cell[a]) * m_cell[a] - org[a]) / dir[a];
+                delta[a] = -m_cell[a] / dir[a];
+            } else {  // +0 or -0: never crosses a boundary of this axis
+                step[a] = 0;
+                out[a] = -2;
+                next[a] = kInfinity;
+                delta[a] = kInfinity;
+            }
+        }
+
+        const WatertightRay<float> wr(org, dir);
+        Mailbox mailbox;
+        for (int guard = m_res[0] + m_res[1] + m_res[2] + 3; guard > 0; --guard) {
+            // Test the triangles of this cell not tested before. A hit beyond the cell stays the
+            // pending closest hit (its t is the query's tmax) and is accepted once the walk
+            // reaches the cell that contains it.
+            const size_t c = (size_t(cell[2]) * size_t(m_res[1]) + size_t(cell[1])) * size_t(m_res[0]) + size_t(cell[0]);
+            for (uint32_t r = m_start[c]; r < m_start[c + 1]; ++r) {
+                const uint32_t prim = m_refs[r];
+                if (mailbox.seen(prim)) continue;
+                const TriangleVerts<float>& tri = m_tris[prim];
+                float t, u, v;
+                if (intersect_triangle(wr, tri.p0, tri.p1, tri.p2, tnear, q.tmax, t, u, v) && q.report(t, u, v, prim))
+                    return true;
+            }
+            // Step to the neighbour across the nearest boundary (Amanatides & Woo 1987).
+            const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
+            const float cell_exit = next[a];
+            if (q.tmax <= cell_exit || cell_exit > t_exit || step[a] == 0) return false;
+            cell[a] += step[a];
+            if (cell[a] == out[a]) return false;
+            next[a] += delta[a];
+        }
+        return false;
+    }
+
+    Bounds3f bounds() const { return m_bounds; }
+    BlasStats stats() const {
+        return {m_start.size() * 4 + m_refs.size() * 4 + m_tris.size() * sizeof(m_tris[0]), m_start.size() - 1,
+                m_refs.size(), 0.0};
+    }
+
+private:
+    void choose_resolution(const GridConfig& config) {
+        const Vec3f ext = m_bounds.diagonal();
+        const float max_ext = max_component(ext);
+        // Flat axes get one cell; the volume uses a tiny thickness for them.
+        const float thin = std::max(max_ext * 1e-3f, 1e-30f);
+        const double volume = double(std::max(ext.x, thin)) * std::max(ext.y, thin) * std::max(ext.z, thin);
+        double k = std::cbrt(double(config.lambda) * double(m_tris.size()) / volume);
+        for (;;) {
+            size_t cells = 1;
+            for (int a = 0; a < 3; ++a) {
+                m_res[a] = ext[a] <= thin ? 1 : int(std::clamp(std::round(double(ext[a]) * k), 1.0, double(config.max_resolution)));
+                cells *= size_t(m_res[a]);
+            }
+            if (cells <= config.max_cells) break;
+            k *= 0.9;
+        }
+        // Pad the box slightly so that vertices on its faces land inside a cell.
+        for (int a = 0; a < 3; ++a) {
+            const float pad = std::max(ext[a], max_ext) * 1e-5f + 1e-30f;
+            m_lo[a] = m_bounds.lo[a] - pad;
+            m_hi[a] = m_bounds.hi[a] + pad;
+            m_cell[a] = (m_hi[a] - m_lo[a]) / float(m_res[a]);
+            m_inv_cell[a] = 1.f / m_cell[a];
+        }
+    }
+
+    /// Cells a triangle overlaps (exact overlap test inside its bounding range of cells).
+    template <class F>
+    void for_each_cell(const TriangleVerts<float>& tri, F&& f) const {
+        const Bounds3f b = triangle_bounds(tri);
+        int c0[3], c1[3];
+        for (int a = 0; a < 3; ++a) {
+            c0[a] = std::clamp(int((b.lo[a] - m_lo[a]) * m_inv_cell[a]) - 1, 0, m_res[a] - 1);
+            c1[a] = std::clamp(int((b.hi[a] - m_lo[a]) * m_inv_cell[a]) + 1, 0, m_res[a] - 1);
+        }
+        for (int z = c0[2]; z <= c1[2]; ++z)
+            for (int y = c0[1]; y <= c1[1]; ++y)
+                for (int x = c0[0]; x <= c1[0]; ++x) {
+                    const Vec3f lo{m_lo[0] + float(x) * m_cell[0], m_lo[1] + float(y) * m_cell[1], m_lo[2] + float(z) * m_cell[2]};
+                    const Vec3f hi = lo + Vec3f(m_cell[0], m_cell[1], m_cell[2]);
+                    if (triangle_overlaps_box(lo, hi, tri.p0, tri.p1, tri.p2))
+                        f((size_t(z) * size_t(m_res[1]) + size_t(y)) * size_t(m_res[0]) + size_t(x));
+                }
+    }
+
+    /// Counting sort of (cell, triangle) pairs: counts in parallel per triangle, then fills in
+    /// triangle order, so each cell lists its triangles ascending whatever the thread count.
+    void bin_triangles() {
+        const size_t cells = size_t(m_res[0]) * size_t(m_res[1]) * size_t(m_res[2]);
+        const size_t n = m_tris.size();
+        std::vector<uint32_t> per_tri(n + 1, 0);
+        tbb::parallel_for(size_t(0), n, [&](size_t i) {
+            uint32_t c = 0;
+            for_each_cell(m_tris[i], [&](size_t) { ++c; });
+            per_tri[i + 1] = c;
+        });
+        for (size_t i = 0; i < n; ++i) per_tri[i + 1] += per_tri[i];
+        std::vector<uint32_t> pair_cell(per_tri[n]);
+        tbb::parallel_for(size_t(0), n, [&](size_t i) {
+            uint32_t k = per_tri[i];
+            for_each_cell(m_tris[i], [&](size_t c) { pair_cell[k++] = uint32_t(c); });
+        });
+        m_start.assign(cells + 1, 0);
+        for (uint32_t c : pair_cell) ++m_start[c + 1];
+        for (size_t c = 0; c < cells; ++c) m_start[c + 1] += m_start[c];
+        m_refs.resize(pair_cell.size());
+        std::vector<uint32_t> fill(m_start.begin(), m_start.end() - 1);
+        for (size_t i = 0; i < n; ++i)
+            for (uint32_t k = per_tri[i]; k < per_tri[i + 1]; ++k) m_refs[fill[pair_cell[k]]++] = uint32_t(i);
+    }
+
+    std::vector<TriangleVerts<float>> m_tris;
+    Bounds3f m_bounds;
+    int m_res[3] = {1, 1, 1};
+    float m_lo[3] = {}, m_hi[3] = {}, m_cell[3] = {}, m_inv_cell[3] = {};
+    std::vector<uint32_t> m_start, m_refs;
+};
+
+}  // namespace
+
+std::unique_ptr<Accelerator> create_grid_accelerator(const Scene& scene, const SurfaceFilter& filter,
+                                                     const GridConfig& config) {
+    return std::make_unique<TwoLevelAccelerator<float, TriangleGrid>>(
+        "grid", scene, filter, [&](const Mesh& m) { return TriangleGrid(m, config); }, true);
+}
+
+}  // namespace whitted

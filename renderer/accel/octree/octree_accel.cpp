@@ -1,0 +1,175 @@
+#include "renderer/accel/octree/octree_accel.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <memory>
+
+#include "renderer/accel/common/mailbox.h"
+#include "renderer/accel/common/two_level.h"
+
+namespace whitted {
+
+namespace {
+
+constexpr int kOctreeHardMaxDepth = 20;
+constexpr uint32_t kInner = ~0u;
+
+/// Child c of a cube: bit 0 = upper half in x, bit 1 in y, bit 2 in z. Build and traversal
+/// compute child boxes with this same arithmetic, so they agree to the bit.
+inline void child_box(const Vec3f& lo, const Vec3f& hi, int c, Vec3f& clo, Vec3f& chi) {
+    const Vec3f mid = (lo + hi) * 0.5f;
+    for (int a = 0; a < 3; ++a) {
+        const bool upper = (c >> a) & 1;
+        clo[a] = upper ? mid[a] : lo[a];
+        chi[a] = upper ? hi[a] : mid[a];
+    }
+}
+
+class TriangleOctree {
+public:
+    TriangleOctree(const Mesh& mesh, const OctreeConfig& config) : m_tris(mesh_triangles<float>(mesh)), m_config(config) {
+        for (const auto& t : m_tris) m_bounds.extend(triangle_bounds(t));
+        // A cube around the mesh, padded so that vertices on its faces are inside.
+        const Vec3f c = m_bounds.center();
+        const float half = max_component(m_bounds.diagonal()) * 0.5f * (1.f + 1e-5f) + 1e-30f;
+        m_root_lo = c - Vec3f(half);
+        m_root_hi = c + Vec3f(half);
+        m_min_extent = 2.f * half * config.min_extent;
+        m_max_depth = std::clamp(config.max_depth, 0, kOctreeHardMaxDepth);
+
+        std::vector<uint32_t> all(m_tris.size());
+        for (size_t i = 0; i < all.size(); ++i) all[i] = uint32_t(i);
+        std::unique_ptr<TempNode> root = build(std::move(all), m_root_lo, m_root_hi, 0, 0);
+        flatten(*root);
+    }
+
+    template <class Query>
+    bool traverse(const Vec3f& org, const Vec3f& dir, float tnear, Query& q) const {
+        const SlabRay<float> slab(org, dir);
+        const WatertightRay<float> wr(org, dir);
+        // Children are visited in the order i ^ mask, i = 0..7: a ray crosses each midplane at
+        // most once, in the direction of its sign, so this is front to back for any ray.
+        const int mask = (std::signbit(dir.x) ? 1 : 0) | (std::signbit(dir.y) ? 2 : 0) | (std::signbit(dir.z) ? 4 : 0);
+        struct Entry {
+            uint32_t node;
+            Vec3f lo, hi;
+        };
+        Entry stack[8 * kOctreeHardMaxDepth + 8];
+        int sp = 0;
+        stack[sp++] = {0, m_root_lo, m_root_hi};
+        Mailbox mailbox;
+        while (sp > 0) {
+            const Entry e = stack[--sp];
+            // Skip nodes the ray misses or that lie beyond the current closest hit.
+            if (slab_entry(slab, e.lo, e.hi, tnear, q.tmax) == kInfinity) continue;
+            const Node& n = m_nodes[e.node];
+            if (n.count != kInner) {
+                for (uint32_t r = n.index; r < n.index + n.count; ++r) {
+                    const uint32_t prim = m_refs[r];
+                    if (mailbox.seen(prim)) continue;
+                    const TriangleVerts<float>& tri = m_tris[prim];
+                    float t, u, v;
+                    if (intersect_triangle(wr, tri.p0, tri.p1, tri.p2, tnear, q.tmax, t, u, v) && q.report(t, u, v, prim))
+                        return true;
+                }
+                continue;
+            }
+            for (int i = 7; i >= 0; --i) {
+                const int c = i ^ mask;
+                Entry& ce = stack[sp++];
+                ce.node = n.index + uint32_t(c);
+                child_box(e.lo, e.hi, c, ce.lo, ce.hi);
+            }
+        }
+        return false;
+    }
+
+    Bounds3f bounds() const { return m_bounds; }
+    BlasStats stats() const {
+        return {m_nodes.size() * sizeof(Node) + m_refs.size() * 4 + m_tris.size() * sizeof(m_tris[0]), m_nodes.size(),
+                m_refs.size(), 0.0};
+    }
+
+private:
+    struct Node {
+        uint32_t index;   ///< first of 8 children (inner) or first reference (leaf)
+        uint32_t count;   ///< kInner or the leaf's reference count
+    };
+    struct TempNode {
+        std::vector<uint32_t> prims;
+        std::array<std::unique_ptr<TempNode>, 8> children;
+        bool leaf() const { return !children[0]; }
+    };
+
+    std::unique_ptr<TempNode> build(std::vector<uint32_t> prims, const Vec3f& lo, const Vec3f& hi, int depth,
+                                    int stalled) const {
+        auto node = std::make_unique<TempNode>();
+        if (prims.size() <= m_config.max_leaf_size || depth >= m_max_depth || (hi.x - lo.x) * 0.5f < m_min_extent) {
+            node->prims = std::move(prims);
+            return node;
+        }
+        // Distribute the triangles over the 8 children (a triangle may go to several).
+        std::array<std::vector<uint32_t>, 8> sub;
+        std::array<Vec3f, 8> clo, chi;
+        for (int c = 0; c < 8; ++c) child_box(lo, hi, c, clo[size_t(c)], chi[size_t(c)]);
+        for (uint32_t p : prims) {
+            const TriangleVerts<float>& t = m_tris[p];
+            for (int c = 0; c < 8; ++c)
+                if (triangle_overlaps_box(clo[size_t(c)], chi[size_t(c)], t.p0, t.p1, t.p2)) sub[size_t(c)].push_back(p);
+        }
+        bool stalls = false;
+        for (const auto& s : sub) stalls |= s.size() == prims.size();
+        const int next_stalled = stalls ? stalled + 1 : 0;
+        if (next_stalled > m_config.max_stalled_levels) {  // no progress: keep them together
+            node->prims = std::move(prims);
+            return node;
+        }
+        auto build_child = [&](size_t c) {
+            node->children[c] = build(std::move(sub[c]), clo[c], chi[c], depth + 1, next_stalled);
+        };
+        if (prims.size() >= 4096) tbb::parallel_for(size_t(0), size_t(8), build_child);
+        else
+            for (size_t c = 0; c < 8; ++c) build_child(c);
+        return node;
+    }
+
+    /// Breadth-first into the flat array: the 8 children of a node are consecutive.
+    void flatten(const TempNode& root) {
+        std::vector<const TempNode*> order{&root};
+        m_nodes.push_back({0, 0});
+        for (size_t i = 0; i < order.size(); ++i) {
+            const TempNode& t = *order[i];
+            if (t.leaf()) {
+                m_nodes[i] = {uint32_t(m_refs.size()), uint32_t(t.prims.size())};
+                m_refs.insert(m_refs.end(), t.prims.begin(), t.prims.end());
+                continue;
+            }
+            m_nodes[i] = {uint32_t(m_nodes.size()), kInner};
+            for (const auto& c : t.children) {
+                order.push_back(c.get());
+                m_nodes.push_back({0, 0});
+            }
+        }
+    }
+
+    std::vector<TriangleVerts<float>> m_tris;
+    OctreeConfig m_config;
+    Bounds3f m_bounds;
+    Vec3f m_root_lo, m_root_hi;
+    float m_min_extent = 0.f;
+    int m_max_depth = 12;
+    std::vector<Node> m_nodes;
+    std::vector<uint32_t> m_refs;
+};
+
+}  // namespace
+
+std::unique_ptr<Accelerator> create_octree_accelerator(const Scene& scene, const SurfaceFilter& filter,
+                                                       const OctreeConfig& config) {
+    return std::make_unique<TwoLevelAccelerator<float, TriangleOctree>>(
+        "octree", scene, filter, [&](const Mesh& m) { return TriangleOctree(m, config); }, true);
+}
+
+}  // namespace whitted

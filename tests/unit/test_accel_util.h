@@ -1,0 +1,179 @@
+// Shared pieces of the accelerator tests: procedural meshes, filters with known answers, ray
+// sets (random and edge cases) and the hit comparison with its tie rule.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "renderer/accel/accelerator.h"
+#include "renderer/accel/common/geometry.h"
+#include "renderer/scene/scene.h"
+
+namespace whitted::test {
+
+/// Every mesh opaque, no filter calls.
+class OpaqueFilter final : public SurfaceFilter {
+public:
+    bool accept(const Ray&, const Hit&, RayKind) const override { return true; }
+    Color transmittance(const Ray&, const Hit&) const override { return Color(0.f); }
+    uint32_t mesh_flags(uint32_t) const override { return 0; }
+};
+
+/// Filter with closed-form answers: meshes with an odd index need accept(), which rejects every
+/// third triangle (a cut-out); meshes with index % 3 == 2 are transparent with Kt depending on
+/// the mesh (per channel) so that products reveal double counting.
+class PatternFilter final : public SurfaceFilter {
+public:
+    bool accept(const Ray&, const Hit& h, RayKind) const override { return h.prim % 3 != 0; }
+    Color transmittance(const Ray&, const Hit& h) const override {
+        if (h.geom % 3 != 2) return h.geom % 2 == 1 && h.prim % 3 == 0 ? Color(1.f) : Color(0.f);
+        return Color(0.9f, 0.8f - 0.01f * float(h.geom % 7), 0.5f);
+    }
+    uint32_t mesh_flags(uint32_t g) const override {
+        uint32_t f = 0;
+        if (g % 2 == 1) f |= kNeedsAccept | kNeedsTransmittance;
+        if (g % 3 == 2) f |= kNeedsTransmittance;
+        return f;
+    }
+};
+
+inline Mesh make_uv_sphere(Vec3f c, float r, int rings, int segments) {
+    Mesh m;
+    m.name = "sphere";
+    for (int i = 0; i <= rings; ++i)
+        for (int j = 0; j <= segments; ++j) {
+            const float th = kPi * float(i) / float(rings), ph = 2.f * kPi * float(j) / float(segments);
+            m.positions.push_back(c + Vec3f(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)) * r);
+        }
+    for (int i = 0; i < rings; ++i)
+        for (int j = 0; j < segments; ++j) {
+            const uint32_t a = uint32_t(i * (segments + 1) + j), b = a + uint32_t(segments + 1);
+            for (uint32_t k : {a, b, a + 1, a + 1, b, b + 1}) m.indices.push_back(k);
+        }
+    m.normals.assign(m.positions.size(), Vec3f(0, 1, 0));
+    return m;
+}
+
+inline Mesh make_soup(uint32_t n, uint32_t seed, float extent, float size) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> pos(-extent, extent), off(-size, size);
+    Mesh m;
+    m.name = "soup";
+    for (uint32_t i = 0; i < n; ++i) {
+        const Vec3f c{pos(rng), pos(rng), pos(rng)};
+        for (int k = 0; k < 3; ++k) {
+            m.positions.push_back(c + Vec3f(off(rng), off(rng), off(rng)));
+            m.indices.push_back(uint32_t(m.positions.size() - 1));
+        }
+    }
+    m.normals.assign(m.positions.size(), Vec3f(0, 1, 0));
+    return m;
+}
+
+/// Height field on [-1, 1]^2 (grid of quads split in two), z up.
+inline Mesh make_terrain(int n, float amplitude) {
+    Mesh m;
+    m.name = "terrain";
+    for (int y = 0; y <= n; ++y)
+        for (int x = 0; x <= n; ++x) {
+            const float u = -1.f + 2.f * float(x) / float(n), v = -1.f + 2.f * float(y) / float(n);
+            m.positions.push_back({u, v, amplitude * std::sin(4.f * u) * std::cos(3.f * v)});
+        }
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const uint32_t a = uint32_t(y * (n + 1) + x), b = a + 1, c = a + uint32_t(n + 1), d = c + 1;
+            for (uint32_t k : {a, b, d, a, d, c}) m.indices.push_back(k);
+        }
+    m.normals.assign(m.positions.size(), Vec3f(0, 0, 1));
+    return m;
+}
+
+inline void add_instance(Scene& s, uint32_t mesh, const Mat4d& xf = Mat4d::identity()) {
+    Instance inst;
+    inst.mesh = mesh;
+    inst.world_from_object = xf;
+    s.instances.push_back(inst);
+}
+
+inline uint32_t add_mesh_instance(Scene& s, Mesh m, const Mat4d& xf = Mat4d::identity()) {
+    s.meshes.push_back(std::move(m));
+    add_instance(s, uint32_t(s.meshes.size() - 1), xf);
+    return uint32_t(s.meshes.size() - 1);
+}
+
+/// World-space vertices of triangle `prim` of instance `inst`.
+inline void world_triangle(const Scene& s, uint32_t inst, uint32_t prim, Vec3d p[3]) {
+    const Instance& in = s.instances[inst];
+    const Mesh& m = s.meshes[in.mesh];
+    for (int k = 0; k < 3; ++k) p[k] = in.world_from_object.apply_point(Vec3d(m.positions[m.indices[3 * prim + uint32_t(k)]]));
+}
+
+/// Random rays from around the scene box towards points inside it, plus the edge cases: through
+/// vertices, through edge midpoints, parallel to the axes (with +0 and -0 components), origins on
+/// surfaces (tnear = 0). Rays with `tfar` set exactly to a hit are added by the tests.
+inline std::vector<Ray> make_rays(const Scene& s, uint32_t count, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    const Bounds3d b = s.world_bounds();
+    const Vec3d c = b.center(), d = b.diagonal();
+    auto inside = [&] { return Vec3d{b.lo.x + u01(rng) * d.x, b.lo.y + u01(rng) * d.y, b.lo.z + u01(rng) * d.z}; };
+    auto outside = [&] {
+        const double th = std::acos(2 * u01(rng) - 1), ph = 2 * 3.14159265358979 * u01(rng);
+        return c + Vec3d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)) * (length(d) * 1.5);
+    };
+    std::vector<Ray> rays;
+    auto add = [&](Vec3d o, Vec3d target) {
+        Ray r;
+        r.org = Vec3f(o);
+        r.dir = Vec3f(target - o);
+        rays.push_back(r);
+    };
+    for (uint32_t i = 0; i < count; ++i) add(u01(rng) < 0.7 ? outside() : inside(), inside());
+    // Through vertices and edge midpoints of random triangles.
+    std::uniform_int_distribution<size_t> pick_inst(0, s.instances.size() - 1);
+    for (uint32_t i = 0; i < count / 4 && !s.instances.empty(); ++i) {
+        const uint32_t inst = uint32_t(pick_inst(rng));
+        const Mesh& m = s.meshes[s.instances[inst].mesh];
+        if (m.triangle_count() == 0) continue;
+        const uint32_t prim = uint32_t(rng() % m.triangle_count());
+        Vec3d p[3];
+        world_triangle(s, inst, prim, p);
+        add(outside(), p[i % 3]);
+        add(outside(), (p[i % 3] + p[(i + 1) % 3]) * 0.5);
+        // Origin on the surface, leaving it.
+        Ray r;
+        r.org = Vec3f((p[0] + p[1] + p[2]) * (1.0 / 3.0));
+        r.dir = Vec3f(outside() - Vec3d(r.org));
+        rays.push_back(r);
+    }
+    // Axis-parallel rays through the box, both signs of zero in the other components.
+    for (uint32_t i = 0; i < count / 8; ++i) {
+        const int axis = int(i % 3);
+        Vec3d o = inside();
+        o[axis] = b.lo[axis] - 0.5 * d[axis] - 1.0;
+        Ray r;
+        r.org = Vec3f(o);
+        r.dir = Vec3f(0.f);
+        r.dir[axis] = 1.f;
+        if (i & 8) r.dir[(axis + 1) % 3] = -0.f;
+        rays.push_back(r);
+    }
+    return rays;
+}
+
+/// Outcome of comparing a backend's closest hit with the oracle's on one ray.
+enum class Agreement { Same, Tie, Differ };
+
+/// Same primitive (and t within `rel_tol`), or a tie: a different primitive at the same t within
+/// `rel_tol` (shared edges and vertices, coplanar overlaps), which either backend may report.
+inline Agreement compare_hits(const Hit& a, const Hit& b, float rel_tol) {
+    if (!a.valid() || !b.valid()) return a.valid() == b.valid() ? Agreement::Same : Agreement::Differ;
+    const bool close = std::fabs(a.t - b.t) <= rel_tol * std::max(std::fabs(a.t), std::fabs(b.t));
+    if (a.prim == b.prim && a.geom == b.geom && a.inst == b.inst) return close ? Agreement::Same : Agreement::Differ;
+    return close ? Agreement::Tie : Agreement::Differ;
+}
+
+}  // namespace whitted::test
