@@ -39,7 +39,7 @@ def inline(path):
     """The glTF at `path` with external buffers/images replaced by data: URIs; None if unreadable."""
     try:
         doc = json.loads(path.read_bytes())
-    except (ValueError, UnicodeDecodeError):
+    except (ValueError, UnicodeDecodeError, RecursionError):
         return None
     if not isinstance(doc, dict):
         return None
@@ -84,7 +84,7 @@ def glb_images(data):
         doc = json.loads(data[20:20 + jlen])
         blen, _ = struct.unpack_from("<I4s", data, 20 + jlen)
         bin_chunk = data[28 + jlen:28 + jlen + blen]
-    except (struct.error, ValueError, UnicodeDecodeError):
+    except (struct.error, ValueError, UnicodeDecodeError, RecursionError):
         return
     if magic != b"glTF":
         return

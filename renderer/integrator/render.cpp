@@ -20,6 +20,18 @@
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
 
+#if defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#include <sanitizer/tsan_interface.h>
+#define RT_TSAN_RELEASE(p) __tsan_release(p)
+#define RT_TSAN_ACQUIRE(p) __tsan_acquire(p)
+#endif
+#endif
+#ifndef RT_TSAN_RELEASE
+#define RT_TSAN_RELEASE(p) ((void)(p))
+#define RT_TSAN_ACQUIRE(p) ((void)(p))
+#endif
+
 namespace whitted {
 
 namespace {
@@ -380,8 +392,11 @@ Film Renderer::render(const AaSettings& aa, RenderStats* stats) const {
 
     // Runs `body(tile rectangle, counters)` over every tile in parallel.
     auto for_each_tile = [&](auto&& body) {
+        char fork_token = 0, join_token = 0;  // ThreadSanitizer: TBB's fork/join, made visible
+        RT_TSAN_RELEASE(&fork_token);
         arena.execute([&] {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, tile_count, 1), [&](const tbb::blocked_range<size_t>& range) {
+                RT_TSAN_ACQUIRE(&fork_token);
                 RayCounters& rc = counters.local();
                 for (size_t tile = range.begin(); tile != range.end(); ++tile) {
                     const int tx = int(tile % size_t(tiles_x)), ty = int(tile / size_t(tiles_x));
@@ -393,8 +408,10 @@ Film Renderer::render(const AaSettings& aa, RenderStats* stats) const {
                     body(r, rc);
                     progress.advance();
                 }
+                RT_TSAN_RELEASE(&join_token);
             });
         });
+        RT_TSAN_ACQUIRE(&join_token);
     };
 
     auto start = Clock::now();
