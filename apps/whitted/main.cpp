@@ -20,6 +20,7 @@
 #include "apps/whitted/command.h"
 #include "importers/scene_loader.h"
 #include "importers/scene_report.h"
+#include "renderer/accel/embree/embree_accel.h"
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
 #include "renderer/integrator/render.h"
@@ -32,12 +33,6 @@ Command register_bench_accel(CLI::App& bench);  ///< `whitted bench accel` (apps
 }  // namespace whitted::app
 using whitted::app::register_bench_aa;
 using whitted::app::register_bench_accel;
-
-// Process-wide hooks defined next to what they act on.
-namespace whitted {
-void remove_partial_output() noexcept;       ///< renderer/output/image_output.cpp: signal-safe
-void set_embree_memory_limit(size_t bytes);  ///< renderer/accel/embree/embree_accel.cpp
-}  // namespace whitted
 
 namespace {
 

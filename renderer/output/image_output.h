@@ -53,6 +53,10 @@ struct OutputSettings {
 /// Throws whitted::Error naming the file on failure (unknown extension, OIIO error).
 void write_image(const Film& film, const std::string& path, const OutputSettings& settings);
 
+/// Removes the temporary file of a write in progress, if any (async-signal-safe: for SIGINT/SIGTERM
+/// handlers, so an interrupted write leaves nothing behind).
+void remove_partial_output() noexcept;
+
 /// Reads an image into linear float RGB (EXR as stored; 8/16-bit files decoded by OIIO as
 /// stored, no color conversion). For tests and comparisons.
 std::vector<float> read_image_rgb(const std::string& path, int& width, int& height);

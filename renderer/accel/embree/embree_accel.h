@@ -1,6 +1,7 @@
 // Embree 3 backend: the production path.
 #pragma once
 
+#include <cstddef>
 #include <memory>
 
 #include "renderer/accel/accelerator.h"
@@ -13,6 +14,10 @@ struct EmbreeConfig {
     bool robust = false;   ///< RTC_SCENE_FLAG_ROBUST: slower traversal that avoids some edge misses
     int threads = 0;       ///< build threads, 0 = all
 };
+
+/// Ceiling on the bytes all Embree devices may hold at once (enforced by the device memory
+/// monitor; exceeding it is a whitted::Error). Default 8 GiB, the CLI sets --max-memory.
+void set_embree_memory_limit(size_t bytes);
 
 /// Builds Embree scenes for `scene` (one triangle scene per mesh, one instance per Instance).
 /// Throws whitted::Error when Embree reports an error (the device callback routes to it).
