@@ -5,8 +5,11 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "renderer/accel/accelerator.h"
+#include "renderer/accel/common/geometry.h"
+#include "renderer/accel/common/two_level.h"
 
 namespace whitted {
 
@@ -28,5 +31,23 @@ public:
 private:
     uint32_t m_prims[kSize];
 };
+
+/// Tests the triangles refs[begin, end) that the mailbox has not seen yet against the query `q`
+/// (its tmax shrinks as hits are reported); true when the query asks to stop (any-hit answered).
+/// The leaf loop shared by the grid's cells and the octree's leaves.
+template <typename Query>
+inline bool test_mailboxed_refs(const std::vector<uint32_t>& refs, uint32_t begin, uint32_t end,
+                                const std::vector<TriangleVerts<float>>& tris, Mailbox& mailbox,
+                                const WatertightRay<float>& wr, float tnear, Query& q) {
+    for (uint32_t r = begin; r < end; ++r) {
+        const uint32_t prim = refs[r];
+        if (mailbox.seen(prim)) continue;
+        const TriangleVerts<float>& tri = tris[prim];
+        float t, u, v;
+        if (intersect_triangle(wr, tri.p0, tri.p1, tri.p2, tnear, q.tmax, t, u, v) && q.report(t, u, v, prim))
+            return true;
+    }
+    return false;
+}
 
 }  // namespace whitted

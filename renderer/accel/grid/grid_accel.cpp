@@ -65,14 +65,7 @@ public:
             // pending closest hit (its t is the query's tmax) and is accepted once the walk
             // reaches the cell that contains it.
             const size_t c = (size_t(cell[2]) * size_t(m_res[1]) + size_t(cell[1])) * size_t(m_res[0]) + size_t(cell[0]);
-            for (uint32_t r = m_start[c]; r < m_start[c + 1]; ++r) {
-                const uint32_t prim = m_refs[r];
-                if (mailbox.seen(prim)) continue;
-                const TriangleVerts<float>& tri = m_tris[prim];
-                float t, u, v;
-                if (intersect_triangle(wr, tri.p0, tri.p1, tri.p2, tnear, q.tmax, t, u, v) && q.report(t, u, v, prim))
-                    return true;
-            }
+            if (test_mailboxed_refs(m_refs, m_start[c], m_start[c + 1], m_tris, mailbox, wr, tnear, q)) return true;
             // Step to the neighbour across the nearest boundary (Amanatides & Woo 1987).
             const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
             const float cell_exit = next[a];

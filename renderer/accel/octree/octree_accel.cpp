@@ -66,14 +66,7 @@ public:
             if (slab_entry(slab, e.lo, e.hi, tnear, q.tmax) == kInfinity) continue;
             const Node& n = m_nodes[e.node];
             if (n.count != kInner) {
-                for (uint32_t r = n.index; r < n.index + n.count; ++r) {
-                    const uint32_t prim = m_refs[r];
-                    if (mailbox.seen(prim)) continue;
-                    const TriangleVerts<float>& tri = m_tris[prim];
-                    float t, u, v;
-                    if (intersect_triangle(wr, tri.p0, tri.p1, tri.p2, tnear, q.tmax, t, u, v) && q.report(t, u, v, prim))
-                        return true;
-                }
+                if (test_mailboxed_refs(m_refs, n.index, n.index + n.count, m_tris, mailbox, wr, tnear, q)) return true;
                 continue;
             }
             for (int i = 7; i >= 0; --i) {
