@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,13 +41,31 @@ struct Instance {
     int32_t node = -1;                ///< glTF node index, -1 when not from a glTF node
 };
 
-/// Analytic sphere (scene-file primitive; later issue). Kept here so every stage knows it exists.
+/// Analytic sphere (scene files), intersected by its quadratic in every backend. Shading UVs:
+/// u = (atan2(d.x, d.z) / 2pi) + 0.5 (longitude about +Y), v = acos(d.y) / pi (0 at the +Y pole),
+/// with d the unit vector from the centre to the point.
 struct Sphere {
     Vec3d center;                     ///< world-space centre
     double radius = 1.0;              ///< world-space radius (> 0)
     uint32_t material = 0;            ///< index into Scene::materials
     std::string name;
 };
+
+/// Infinite plane (scene files): the points p with dot(normal, p - point) = 0. It has no finite
+/// bounds, so it is kept out of every acceleration structure and tested on its own beside them.
+/// Its front side faces `normal`. Shading UVs are world units along `u_axis` and
+/// cross(normal, u_axis) measured from `point`.
+struct Plane {
+    Vec3d point;                      ///< a world-space point on the plane
+    Vec3d normal{0, 1, 0};            ///< unit normal (front side)
+    Vec3d u_axis{1, 0, 0};            ///< unit tangent, perpendicular to normal (UV u direction)
+    uint32_t material = 0;            ///< index into Scene::materials
+    std::string name;
+};
+
+/// Which kind of geometry a geometry id names. Ids are dense: meshes [0, M), spheres
+/// [M, M + S), planes [M + S, M + S + P) (Hit::geom, SurfaceFilter::mesh_flags).
+enum class GeomKind : uint8_t { Mesh, Sphere, Plane };
 
 // ---------------------------------------------------------------------------------------------
 // Textures
@@ -60,12 +79,29 @@ struct MipLevel {
     std::vector<uint8_t> texels;      ///< width * height * 4 bytes
 };
 
+/// What a texture is: decoded texels, or a procedural pattern evaluated per lookup.
+enum class TextureKind : uint8_t { Image, Checker };
+
+/// Procedural checkerboard (Whitted 1980's floor). Squares of side `size` (UV or world units)
+/// alternate between `color_a` (the square at the origin's positive corner) and `color_b`.
+/// In UV space the parity is floor(u/size) + floor(v/size); in world space it is the 3D solid
+/// checker floor(x/size) + floor(y/size) + floor(z/size), evaluated a tiny step inside the
+/// surface so points on an axis-aligned face never flicker between two cells.
+struct Checker {
+    Color color_a{1.f};               ///< linear RGB
+    Color color_b{0.f};               ///< linear RGB
+    float size = 1.f;                 ///< side of one square (> 0)
+    bool world_space = false;         ///< false: UV set of the TextureRef; true: world position
+};
+
 /// A decoded texture. Texels stay 8-bit to keep memory in check (a 2k RGBA level is 16 MB);
 /// `srgb` says whether the lookup converts them from the sRGB transfer to linear, so every value
 /// a lookup returns is linear. levels[0] is full resolution; each next level halves (box filter
 /// in linear space).
 struct Texture {
     std::string name;                 ///< image name or URI, for messages
+    TextureKind kind = TextureKind::Image;
+    Checker checker;                  ///< TextureKind::Checker only
     std::vector<MipLevel> levels;
     bool srgb = false;                ///< true for color data (baseColor, emissive)
     WrapMode wrap_s = WrapMode::Repeat;
@@ -152,6 +188,7 @@ struct Material {
 
     // MaterialModel::Classic: the seed's parameters, used as given.
     WhittedCoeffs classic;
+    TextureRef classic_color_texture;          ///< Classic: RGB multiplies kd and ka (checker or image)
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -211,22 +248,62 @@ struct ExtensionUse {
 };
 
 // ---------------------------------------------------------------------------------------------
+// Render settings a scene file may carry; command-line flags override them. Unset = the
+// renderer's default.
+
+struct SceneRenderSettings {
+    std::optional<int> width, height;            ///< pixels
+    std::optional<std::string> aa;               ///< center, corners, adaptive, stratified
+    std::optional<float> aa_threshold;           ///< adaptive: contrast threshold
+    std::optional<int> aa_depth;                 ///< adaptive: maximum subdivision depth
+    std::optional<int> spp;                      ///< stratified: samples per pixel (k*k)
+    std::optional<int> max_depth;                ///< maximum depth of the ray tree
+    std::optional<float> min_weight;             ///< adaptive ray-tree depth cutoff (Hall & Greenberg)
+    std::optional<Color> background;             ///< radiance of rays that hit nothing (linear)
+    std::optional<Color> ambient;                ///< Ia (linear)
+    std::optional<float> exposure;               ///< stops
+    std::optional<bool> fresnel;                 ///< Schlick-weighted kr / kt
+    std::optional<std::string> output;           ///< output file, relative to the scene file's folder
+    std::optional<std::string> view;             ///< OCIO view
+    std::optional<std::string> display;          ///< OCIO display
+    std::optional<int> camera;                   ///< index into Scene::cameras
+};
+
+// ---------------------------------------------------------------------------------------------
 
 struct Scene {
     std::string source;               ///< file the scene came from
     std::vector<Mesh> meshes;
     std::vector<Instance> instances;
     std::vector<Sphere> spheres;
+    std::vector<Plane> planes;        ///< infinite planes (outside the acceleration structures)
     std::vector<Material> materials;  ///< never empty after import (a default material is added)
     std::vector<Texture> textures;
     std::vector<Light> lights;
     std::vector<Camera> cameras;
     std::vector<ExtensionUse> extensions;
     std::vector<std::string> warnings;  ///< each distinct warning once
+    SceneRenderSettings settings;     ///< from a scene file; empty for glTF
+
+    /// Geometry ids (see GeomKind): meshes, then spheres, then planes.
+    uint32_t sphere_geom_id(size_t sphere) const { return uint32_t(meshes.size() + sphere); }
+    uint32_t plane_geom_id(size_t plane) const { return uint32_t(meshes.size() + spheres.size() + plane); }
+    uint32_t geometry_count() const { return uint32_t(meshes.size() + spheres.size() + planes.size()); }
+    GeomKind geom_kind(uint32_t geom) const {
+        return geom < meshes.size() ? GeomKind::Mesh
+                                    : geom < meshes.size() + spheres.size() ? GeomKind::Sphere : GeomKind::Plane;
+    }
+    /// Material of any geometry id.
+    uint32_t geom_material(uint32_t geom) const {
+        if (geom < meshes.size()) return meshes[geom].material;
+        if (geom < meshes.size() + spheres.size()) return spheres[geom - meshes.size()].material;
+        return planes[geom - meshes.size() - spheres.size()].material;
+    }
 
     /// Adds a warning unless the same text was already recorded.
     void warn(const std::string& message);
-    /// World-space bounds of all instances and spheres (computed, not cached).
+    /// World-space bounds of all instances and spheres (computed, not cached; planes are infinite
+    /// and not included).
     Bounds3d world_bounds() const;
     /// Total triangles over instances (a mesh used twice counts twice).
     size_t instanced_triangle_count() const;
