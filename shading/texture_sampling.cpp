@@ -272,4 +272,46 @@ void build_mip_levels(Texture& texture) {
     }
 }
 
+namespace {
+
+/// Mean over [x - w/2, x + w/2] of the square wave that is +1 on even cells [2k, 2k+1) and -1 on
+/// odd ones; w <= 0 point-samples it. The integral of the odd-cell indicator is the ramp
+/// I(x) = floor(x/2) + 2 max(x/2 - floor(x/2) - 1/2, 0) (pbrt-v3, Checkerboard2DTexture).
+double filtered_square_wave(double x, double w) {
+    if (!(w > 1e-6)) return std::fmod(std::abs(std::floor(x)), 2.0) < 0.5 ? 1.0 : -1.0;
+    if (w >= 2.0) return 0.0;  // the footprint covers whole periods (near enough): the mean
+    auto ramp = [](double y) {
+        const double h = y / 2.0, f = std::floor(h);
+        return f + 2.0 * std::max(h - f - 0.5, 0.0);
+    };
+    const double odd = (ramp(x + w / 2) - ramp(x - w / 2)) / w;
+    return std::clamp(1.0 - 2.0 * odd, -1.0, 1.0);
+}
+
+}  // namespace
+
+Color sample_checker(const Checker& c, Vec2f uv, const Vec3f& p, const Vec3f& n, float width) {
+    const double inv = 1.0 / double(c.size);
+    const double w = std::isfinite(width) && width > 0.f ? double(width) * inv : 0.0;  // footprint in squares
+    // The checker is the product of one square wave per axis; a box filter of the product over a
+    // separable footprint is the product of the filtered waves, and the fraction of "a" squares
+    // is (1 + product) / 2.
+    double product = 1.0;
+    if (c.world_space) {
+        // 3D solid checker, evaluated a tiny step inside the surface so points on a face lying on
+        // a cell boundary all pick the same cell. The footprint lies in the tangent plane: its
+        // extent along world axis i is w sqrt(1 - n_i^2) (0 along a face's own normal).
+        const Vec3d q = Vec3d(p - n * (1e-4f * c.size)) * inv;
+        if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) return c.color_a;
+        for (int i = 0; i < 3; ++i)
+            product *= filtered_square_wave(q[i], w * std::sqrt(std::max(0.0, 1.0 - double(n[i]) * double(n[i]))));
+    } else {
+        const double s = double(uv.x) * inv, t = double(uv.y) * inv;
+        if (!std::isfinite(s) || !std::isfinite(t)) return c.color_a;
+        product = filtered_square_wave(s, w) * filtered_square_wave(t, w);
+    }
+    const float frac_a = float(std::clamp(0.5 * (1.0 + product), 0.0, 1.0));
+    return c.color_a * frac_a + c.color_b * (1.f - frac_a);
+}
+
 }  // namespace whitted

@@ -21,6 +21,15 @@ Vec2f apply_texture_transform(const TextureTransform& xf, Vec2f uv);
 /// A texture without levels returns (1, 1, 1, 1).
 Vec4f sample_texture(const Texture& texture, Vec2f uv, float lod = 0.f);
 
+/// Procedural checkerboard (scene.h: Checker) at UV `uv` or, for a world-space checker, at the
+/// world point `p` with unit normal `n`. `width` is the footprint's width in UV units (world
+/// units for world-space checkers; 0 = point sample): UV-space checkers are box-filtered over it
+/// in closed form (integral of the square wave, as pbrt-v3's Checkerboard2DTexture), so distant
+/// squares fade to the mean color instead of aliasing; footprints of 2 squares or more return the
+/// mean. World-space checkers are point-sampled a tiny step (1e-4 size) inside the surface, so
+/// faces lying on a cell boundary pick one cell.
+Color sample_checker(const Checker& checker, Vec2f uv, const Vec3f& p, const Vec3f& n, float width = 0.f);
+
 /// Fills texture.levels[1..] from levels[0] by 2x2 box filtering in linear space.
 /// Each level is max(1, floor(size / 2)) of the previous one, down to 1x1. Each destination
 /// texel averages the source texels its footprint covers, weighted by overlap: exactly the 2x2

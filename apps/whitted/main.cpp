@@ -119,13 +119,41 @@ struct RenderOptions {
     std::string aa = "adaptive", filter = "box";
     float aa_threshold = AaSettings{}.threshold;
     int aa_depth = AaSettings{}.depth, spp = AaSettings{}.spp;
-    float exposure = 0.f, mirror_cutoff = 0.3f;
+    float exposure = 0.f, mirror_cutoff = 0.3f, min_weight = 0.f;
     bool fresnel = false, refract_thin = false, robust = false, no_progress = false, exr_float = false;
     double max_memory_gb = 8.0;
     bool allow_outside_uris = false;
 };
 
-int run_render(const RenderOptions& o, const std::string& cmdline) {
+/// Scene-file render settings fill every option the command line did not give (`given(flag)`);
+/// flags always win. A relative output path is taken relative to the scene file (as pbrt does).
+template <class Given>
+void apply_scene_settings(RenderOptions& o, const SceneRenderSettings& s, const std::string& scene_path,
+                          Given&& given) {
+    auto color_text = [](const Color& c) { return fmt::format("{},{},{}", c.x, c.y, c.z); };
+    if (s.width && !given("--width")) o.width = *s.width;
+    if (s.height && !given("--height")) o.height = *s.height;
+    if (s.camera && !given("--camera")) o.camera = *s.camera;
+    if (s.aa && !given("--aa")) o.aa = *s.aa;
+    if (s.aa_threshold && !given("--aa-threshold")) o.aa_threshold = *s.aa_threshold;
+    if (s.aa_depth && !given("--aa-depth")) o.aa_depth = *s.aa_depth;
+    if (s.spp && !given("--spp")) o.spp = *s.spp;
+    if (s.max_depth && !given("--max-depth")) o.max_depth = *s.max_depth;
+    if (s.min_weight && !given("--min-weight")) o.min_weight = *s.min_weight;
+    if (s.background && !given("--background")) o.background = color_text(*s.background);
+    if (s.ambient && !given("--ambient")) o.ambient = color_text(*s.ambient);
+    if (s.exposure && !given("--exposure")) o.exposure = *s.exposure;
+    if (s.fresnel && !given("--fresnel")) o.fresnel = *s.fresnel;
+    if (s.view && !given("--view")) o.view = *s.view;
+    if (s.display && !given("--display")) o.display = *s.display;
+    if (s.output && !given("--output")) {
+        std::filesystem::path out(*s.output);
+        o.output = out.is_absolute() ? out.string() : (std::filesystem::path(scene_path).parent_path() / out).string();
+    }
+}
+
+template <class Given>
+int run_render(RenderOptions o, const std::string& cmdline, Given&& given) {
     install_interrupt_handlers();
     const auto t_load = Clock::now();
     ImportOptions io;
@@ -136,6 +164,9 @@ int run_render(const RenderOptions& o, const std::string& cmdline) {
     Scene scene = load_scene(o.input, io);
     const double load_s = seconds_since(t_load);
     for (const std::string& w : scene.warnings) log_warning("{}: {}", o.input, w);
+    apply_scene_settings(o, scene.settings, o.input, given);
+    if (!(o.min_weight >= 0.f && o.min_weight <= 1.f))
+        throw Error(fmt::format("min_weight {} is out of range (expected 0 to 1)", o.min_weight));
 
     RenderSettings rs;
     rs.width = o.width;
@@ -145,6 +176,7 @@ int run_render(const RenderOptions& o, const std::string& cmdline) {
     rs.integrator.background = parse_color(o.background, "--background");
     rs.integrator.ambient = parse_color(o.ambient, "--ambient");
     rs.integrator.fresnel = o.fresnel;
+    rs.integrator.min_weight = o.min_weight;
     rs.mapping.refract_thin = o.refract_thin;
     rs.mapping.mirror_roughness_cutoff = o.mirror_cutoff;
     rs.exposure = std::exp2(o.exposure);
@@ -239,7 +271,7 @@ int main(int argc, char** argv) {
     // whitted render
     RenderOptions ro;
     CLI::App* render = app.add_subcommand("render", "Render a scene to an image");
-    render->add_option("scene", ro.input, "Scene file (.gltf or .glb)")->required();
+    render->add_option("scene", ro.input, "Scene file (.gltf, .glb, or a .json scene file: docs/scene-format.md)")->required();
     render->add_option("-o,--output", ro.output,
                        "Output image; the extension picks the format: .exr (scene-linear, AOVs), "
                        ".png/.jpg/.tif (display-referred through OCIO)")
@@ -257,6 +289,10 @@ int main(int argc, char** argv) {
     render->add_option("--ambient", ro.ambient, "Ambient light Ia: r,g,b or gray (linear)")->capture_default_str();
     render->add_option("--exposure", ro.exposure, "Exposure in stops: radiance is scaled by 2^exposure")
         ->capture_default_str();
+    render->add_option("--min-weight", ro.min_weight,
+                       "Adaptive tree depth: skip reflected/refracted rays whose accumulated weight is below this "
+                       "(0 = trace to --max-depth)")
+        ->check(CLI::Range(0.0f, 1.0f))->capture_default_str();
     render->add_flag("--fresnel", ro.fresnel, "Weight reflection and transmission with Schlick's Fresnel term");
     render->add_flag("--refract-thin", ro.refract_thin,
                      "Refract through transmissive materials without KHR_materials_volume (classic glass)");
@@ -303,7 +339,7 @@ int main(int argc, char** argv) {
     int info_scene = -1;
     bool info_no_textures = false, info_allow_outside_uris = false;
     CLI::App* info = app.add_subcommand("info", "Print what a scene file contains after import");
-    info->add_option("scene", info_input, "Scene file (.gltf or .glb)")->required();
+    info->add_option("scene", info_input, "Scene file (.gltf, .glb or .json)")->required();
     info->add_option("--scene", info_scene, "glTF scene index (-1 = the file's default scene)")->capture_default_str();
     info->add_flag("--no-textures", info_no_textures, "Skip decoding images");
     info->add_flag("--allow-outside-uris", info_allow_outside_uris,
@@ -338,7 +374,9 @@ int main(int argc, char** argv) {
 
     try {
         set_log_level(parse_log_level(log_level));
-        if (render->parsed()) return run_render(ro, command_line(argc, argv));
+        if (render->parsed())
+            return run_render(ro, command_line(argc, argv),
+                              [&](const char* flag) { return render->count(flag) > 0; });
         if (info->parsed()) return run_info(info_input, info_scene, !info_no_textures, info_allow_outside_uris);
         for (app::Command& c : commands)
             if (c.app->parsed()) return c.run();

@@ -189,6 +189,7 @@ struct Mat4d {
 };
 
 constexpr float kPi = 3.14159265358979323846f;
+constexpr double kPiD = 3.14159265358979323846;
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
 }  // namespace whitted

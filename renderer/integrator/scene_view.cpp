@@ -38,7 +38,9 @@ T interpolate(const std::vector<T>& a, uint32_t i0, uint32_t i1, uint32_t i2, fl
 /// `uv_lod` (per UV set, see SurfacePoint::uv_lod) gives the MIP level: the footprint in texels is
 /// its width in UV units times the texture size (geometric mean of width and height) times the
 /// scale of KHR_texture_transform; -inf selects level 0 with the magnification filter.
-Vec4f lookup(const Scene& scene, const TextureRef& ref, const Vec2f uv[2], const float uv_lod[2]) {
+/// Procedural textures also read the world position `p` and normal `n`.
+Vec4f lookup(const Scene& scene, const TextureRef& ref, const Vec2f uv[2], const float uv_lod[2],
+             const Vec3f& p = Vec3f(0.f), const Vec3f& n = Vec3f(0.f), float world_footprint = 0.f) {
     if (!ref.valid() || size_t(ref.texture) >= scene.textures.size()) return {1.f, 1.f, 1.f, 1.f};
     const uint32_t set = ref.uv_set > 1 ? 0 : ref.uv_set;
     Vec2f t = uv[set];
@@ -48,6 +50,11 @@ Vec4f lookup(const Scene& scene, const TextureRef& ref, const Vec2f uv[2], const
         t = apply_texture_transform(ref.transform, t);
         const float area_scale = std::abs(ref.transform.scale.x * ref.transform.scale.y);
         if (area_scale > 0.f) lod += 0.5f * std::log2(area_scale);
+    }
+    if (texture.kind == TextureKind::Checker) {
+        const float width = texture.checker.world_space ? world_footprint : lod > -kInfinity ? std::exp2(lod) : 0.f;
+        const Color c = sample_checker(texture.checker, t, p, n, width);
+        return {c.x, c.y, c.z, 1.f};
     }
     if (lod > -kInfinity && !texture.levels.empty())
         lod += 0.5f * std::log2(float(texture.levels[0].width) * float(texture.levels[0].height));
@@ -70,13 +77,14 @@ SceneView::SceneView(const Scene& scene, const MappingOptions& mapping) : m_scen
             for (int c = 0; c < 3; ++c) m_xf[i].n[r * 3 + c] = float(inv_t(r, c));
         }
     }
-    // What each mesh needs from traversal.
-    m_mesh_flags.resize(scene.meshes.size());
-    for (size_t g = 0; g < scene.meshes.size(); ++g) {
-        const Material& m = scene.materials[scene.meshes[g].material];
+    // What each geometry (meshes, spheres, planes) needs from traversal.
+    m_mesh_flags.resize(scene.geometry_count());
+    for (uint32_t g = 0; g < scene.geometry_count(); ++g) {
+        const Material& m = scene.materials[scene.geom_material(g)];
+        const bool is_mesh = scene.geom_kind(g) == GeomKind::Mesh;
         uint32_t f = 0;
-        const bool cutout = m.model == MaterialModel::GltfPbr && m.alpha_mode == AlphaMode::Mask;
-        const bool single_sided = m.model == MaterialModel::GltfPbr && !m.double_sided;
+        const bool cutout = is_mesh && m.model == MaterialModel::GltfPbr && m.alpha_mode == AlphaMode::Mask;
+        const bool single_sided = is_mesh && m.model == MaterialModel::GltfPbr && !m.double_sided;
         if (cutout || single_sided) f |= kNeedsAccept;
         const bool transmissive = m.model == MaterialModel::Classic ? !is_black(m.classic.kt)
                                                                     : (m.transmission > 0.f || m.transmission_texture.valid() ||
@@ -97,6 +105,11 @@ Vec3f SceneView::world_geometric_normal(const Hit& hit) const {
 }
 
 SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& cone) const {
+    switch (m_scene.geom_kind(hit.geom)) {
+        case GeomKind::Sphere: return sphere_surface(ray, hit, cone);
+        case GeomKind::Plane: return plane_surface(ray, hit, cone);
+        case GeomKind::Mesh: break;
+    }
     SurfacePoint sp;
     const Mesh& mesh = m_scene.meshes[hit.geom];
     const InstanceXf& xf = m_xf[hit.inst];
@@ -141,6 +154,7 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
     if (width > 0.f) {
         const float world_area = length(cross(p1 - p0, p2 - p0));
         const float cos_theta = std::max(std::abs(dot(ng, ray.dir)), 1e-3f);
+        sp.footprint = width / cos_theta;
         auto footprint = [&](const std::vector<Vec2f>& uvs) {
             const Vec2f a = uvs[i0], b = uvs[i1], c = uvs[i2];
             const float uv_area = std::abs((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y));
@@ -176,6 +190,63 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
     return sp;
 }
 
+SurfacePoint SceneView::sphere_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const {
+    const Sphere& sphere = m_scene.spheres[hit.geom - m_scene.meshes.size()];
+    SurfacePoint sp;
+    sp.material = sphere.material;
+    // o + t d carries the error of t; re-project it onto the sphere in double (pbrt-v4,
+    // Sphere::Intersect), so the point's error is a few ulps of its magnitude whatever the ray.
+    const Vec3d o(ray.org), d(ray.dir);
+    const Vec3d hit_d = o + d * double(hit.t);
+    Vec3d n = hit_d - sphere.center;
+    const double len = length(n);
+    n = len > 0.0 ? n / len : -d;
+    sp.p = Vec3f(sphere.center + n * sphere.radius);
+    sp.p_shadow = sp.p;
+    sp.ng = sp.ns = normalize(Vec3f(n));
+    // Longitude about +Y and colatitude from the +Y pole (scene.h: Sphere).
+    const double u = std::atan2(n.x, n.z) / (2.0 * kPiD) + 0.5;
+    const double v = std::acos(std::clamp(n.y, -1.0, 1.0)) / kPiD;
+    sp.uv[0] = sp.uv[1] = Vec2f{float(u), float(v)};
+    const float width = cone.width_at(hit.t);
+    if (width > 0.f) {
+        // One UV unit spans 2 pi r sin(theta) (u) by pi r (v) world units: mean scale
+        // sqrt(1 / (2 pi^2 r^2 sin(theta))), sin(theta) clamped near the poles.
+        const double sin_theta = std::max(std::sqrt(std::max(0.0, 1.0 - n.y * n.y)), 1e-3);
+        const float cos_theta = std::max(std::abs(dot(sp.ng, ray.dir)), 1e-3f);
+        sp.footprint = width / cos_theta;
+        const double area = 2.0 * kPiD * kPiD * sphere.radius * sphere.radius * sin_theta;
+        const float lod = std::log2(width / cos_theta) - float(0.5 * std::log2(area));
+        sp.uv_lod[0] = sp.uv_lod[1] = std::isfinite(lod) ? lod : -kInfinity;
+    }
+    return sp;
+}
+
+SurfacePoint SceneView::plane_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const {
+    const Plane& plane = m_scene.planes[hit.geom - m_scene.meshes.size() - m_scene.spheres.size()];
+    SurfacePoint sp;
+    sp.material = plane.material;
+    // o + t d, projected back onto the plane in double.
+    const Vec3d o(ray.org), d(ray.dir);
+    Vec3d p = o + d * double(hit.t);
+    p = p - plane.normal * dot(plane.normal, p - plane.point);
+    sp.p = Vec3f(p);
+    sp.p_shadow = sp.p;
+    sp.ng = sp.ns = Vec3f(plane.normal);
+    const Vec3d rel = p - plane.point;
+    const Vec3d v_axis = cross(plane.normal, plane.u_axis);
+    sp.uv[0] = sp.uv[1] = Vec2f{float(dot(rel, plane.u_axis)), float(dot(rel, v_axis))};
+    const float width = cone.width_at(hit.t);
+    if (width > 0.f) {
+        // UV units are world units.
+        const float cos_theta = std::max(std::abs(dot(sp.ng, ray.dir)), 1e-3f);
+        sp.footprint = width / cos_theta;
+        const float lod = std::log2(sp.footprint);
+        sp.uv_lod[0] = sp.uv_lod[1] = std::isfinite(lod) ? lod : -kInfinity;
+    }
+    return sp;
+}
+
 PbrSample SceneView::material_inputs(const Material& m, const SurfacePoint& sp) const {
     PbrSample s;
     Vec4f bc = lookup(m_scene, m.base_color_texture, sp.uv, sp.uv_lod);
@@ -198,7 +269,16 @@ PbrSample SceneView::material_inputs(const Material& m, const SurfacePoint& sp) 
 
 WhittedCoeffs SceneView::coefficients(const SurfacePoint& sp) const {
     const Material& m = m_scene.materials[sp.material];
-    if (m.model == MaterialModel::Classic) return m.classic;
+    if (m.model == MaterialModel::Classic) {
+        WhittedCoeffs c = m.classic;
+        // The scene file's color texture (checker or image) and vertex colors tint kd and Ka.
+        Color tint = sp.color.xyz();
+        if (m.classic_color_texture.valid())
+            tint *= lookup(m_scene, m.classic_color_texture, sp.uv, sp.uv_lod, sp.p, sp.ng, sp.footprint).xyz();
+        c.kd *= tint;
+        c.ka *= tint;
+        return c;
+    }
     return map_gltf_material(m, material_inputs(m, sp), m_mapping);
 }
 
@@ -216,6 +296,7 @@ float SceneView::alpha_at(const Material& m, const Hit& hit) const {
 }
 
 bool SceneView::accept(const Ray& ray, const Hit& hit, RayKind kind) const {
+    if (m_scene.geom_kind(hit.geom) != GeomKind::Mesh) return true;  // analytic: no cut-outs, two-sided
     const Material& m = m_scene.materials[m_scene.meshes[hit.geom].material];
     if (m.model != MaterialModel::GltfPbr) return true;
     if (m.alpha_mode == AlphaMode::Mask && alpha_at(m, hit) < m.alpha_cutoff) return false;
@@ -226,8 +307,13 @@ bool SceneView::accept(const Ray& ray, const Hit& hit, RayKind kind) const {
 }
 
 Color SceneView::transmittance(const Ray& ray, const Hit& hit) const {
-    const Material& m = m_scene.materials[m_scene.meshes[hit.geom].material];
+    const Material& m = m_scene.materials[m_scene.geom_material(hit.geom)];
     if (m.model == MaterialModel::Classic) return m.classic.kt;
+    if (m_scene.geom_kind(hit.geom) != GeomKind::Mesh) {
+        // glTF material on an analytic primitive: Kt at the point (no alpha coverage).
+        const SurfacePoint sp = surface(ray, hit);
+        return map_gltf_material(m, material_inputs(m, sp), m_mapping).kt;
+    }
     float coverage = 1.f;
     if (m.alpha_mode == AlphaMode::Mask) {
         if (alpha_at(m, hit) < m.alpha_cutoff) return Color(1.f);

@@ -34,6 +34,8 @@ struct SurfacePoint {
     float uv_lod[2] = {-kInfinity, -kInfinity};  ///< log2 of the footprint's width in UV units per
                                 ///< UV set (ray cone / |cos| x sqrt(uv area / world area));
                                 ///< -inf = no footprint (point sample, finest MIP level)
+    float footprint = 0.f;      ///< the ray cone's width on the surface (world units, / |cos|);
+                                ///< 0 = point sample (world-space procedural textures)
 };
 
 class SceneView final : public SurfaceFilter {
@@ -59,6 +61,8 @@ private:
     /// Coverage alpha at a hit (base color alpha x texture x vertex alpha), UV0/UV1 interpolated.
     float alpha_at(const Material& m, const Hit& hit) const;
     Vec3f world_geometric_normal(const Hit& hit) const;
+    SurfacePoint sphere_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const;
+    SurfacePoint plane_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const;
 
     struct InstanceXf {
         float m[12];            ///< world_from_object, row-major 3x4

@@ -25,14 +25,16 @@ Color sanitize(const Color& c) {
 
 Color exp_neg(const Color& c) { return {std::exp(-c.x), std::exp(-c.y), std::exp(-c.z)}; }
 
+float max_component(const Color& c) { return std::max(c.x, std::max(c.y, c.z)); }
+
 }  // namespace
 
 Color WhittedIntegrator::trace(const Ray& ray, RayKind kind, int depth, RayCounters& counters,
-                               PrimaryInfo* primary, const RayCone& cone) const {
+                               PrimaryInfo* primary, const RayCone& cone, float weight) const {
     count(counters, kind);
     const Hit hit = m_accel.intersect(ray, kind);
     if (!hit.valid()) return m_settings.background;
-    return sanitize(shade(ray, hit, depth, counters, primary, cone));
+    return sanitize(shade(ray, hit, depth, counters, primary, cone, weight));
 }
 
 void WhittedIntegrator::probe(const Ray& ray, RayCounters& counters, PrimaryInfo& primary) const {
@@ -55,7 +57,7 @@ void WhittedIntegrator::probe(const Ray& ray, RayCounters& counters, PrimaryInfo
 }
 
 Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCounters& counters,
-                               PrimaryInfo* primary, const RayCone& cone) const {
+                               PrimaryInfo* primary, const RayCone& cone, float weight) const {
     const Scene& scene = m_view.scene();
     const SurfacePoint sp = m_view.surface(ray, hit, cone);
     // Secondary rays start where this cone arrived and keep its spread. Surface curvature would
@@ -132,7 +134,10 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                     kt[i] = c.ks[i] < 1.f ? c.kt[i] * (1.f - F[i]) / (1.f - c.ks[i]) : 0.f;
                 }
             }
-            if (!is_black(kt)) {
+            // Hall & Greenberg (1983): a branch whose accumulated weight falls below min_weight
+            // cannot change the pixel visibly; it is not traced.
+            const float wt = weight * max_component(kt);
+            if (!is_black(kt) && wt >= m_settings.min_weight) {
                 Ray t;
                 t.org = offset_ray_origin(sp.p, -Ng);
                 bool transmitted = true;
@@ -145,18 +150,19 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                     else transmitted = false;  // total internal reflection
                 }
                 if (transmitted) {
-                    result += kt * trace(t, RayKind::Refraction, depth + 1, counters, nullptr, secondary);
+                    result += kt * trace(t, RayKind::Refraction, depth + 1, counters, nullptr, secondary, wt);
                 } else {
                     kr += kt;  // the transmitted energy goes to reflection
                 }
             }
-            if (!is_black(kr)) {
+            const float wr = weight * max_component(kr);
+            if (!is_black(kr) && wr >= m_settings.min_weight) {
                 Vec3f R = reflect(V, N);
                 if (dot(R, Ng) <= 0.f) R = reflect(V, Ng);
                 Ray r;
                 r.org = offset_ray_origin(sp.p, Ng);
                 r.dir = normalize(R);
-                result += kr * trace(r, RayKind::Reflection, depth + 1, counters, nullptr, secondary);
+                result += kr * trace(r, RayKind::Reflection, depth + 1, counters, nullptr, secondary, wr);
             }
         }
     }
@@ -171,7 +177,8 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
             Ray behind;
             behind.org = offset_ray_origin(sp.p, -Ng);
             behind.dir = ray.dir;
-            Color b = depth < m_settings.max_depth ? trace(behind, RayKind::Refraction, depth + 1, counters, nullptr, secondary)
+            Color b = depth < m_settings.max_depth ? trace(behind, RayKind::Refraction, depth + 1, counters, nullptr,
+                                                           secondary, weight * (1.f - alpha))
                                                    : m_settings.background;
             result = result * alpha + b * (1.f - alpha);
         }

@@ -13,6 +13,9 @@ struct IntegratorSettings {
     Color background{0.f};             ///< radiance of rays that hit nothing
     Color ambient{0.05f};              ///< Ia, the ambient light (multiplied by Ka)
     bool fresnel = false;              ///< Schlick-weighted kr / kt instead of constant coefficients
+    float min_weight = 0.f;            ///< adaptive tree depth (Hall & Greenberg 1983): a secondary ray
+                                       ///< is traced only while the product of the kr/kt weights along
+                                       ///< its path (max over channels) is >= this; 0 = depth limit only
 };
 
 /// Rays traced, by kind (summed per thread, then added: integer sums are deterministic).
@@ -46,8 +49,10 @@ public:
     /// Radiance arriving along `ray` (a unit-direction ray of the given kind at tree depth
     /// `depth`). Never NaN or infinite. `primary` (optional) receives first-hit data. `cone` is the
     /// ray's footprint for texture filtering; it is carried through reflection and refraction.
+    /// `weight` is the path's accumulated kr/kt weight (1 for camera rays), compared with
+    /// IntegratorSettings::min_weight before secondary rays are spawned.
     Color trace(const Ray& ray, RayKind kind, int depth, RayCounters& counters, PrimaryInfo* primary = nullptr,
-                const RayCone& cone = {}) const;
+                const RayCone& cone = {}, float weight = 1.f) const;
     /// First-hit data only (no shading, no secondary rays) for a camera ray: AOVs of pixel centres
     /// in anti-aliasing modes that trace no centre sample. Counted as `aov_probe`.
     void probe(const Ray& ray, RayCounters& counters, PrimaryInfo& primary) const;
@@ -56,7 +61,7 @@ public:
 
 private:
     Color shade(const Ray& ray, const Hit& hit, int depth, RayCounters& counters, PrimaryInfo* primary,
-                const RayCone& cone) const;
+                const RayCone& cone, float weight) const;
 
     const SceneView& m_view;
     const Accelerator& m_accel;

@@ -257,5 +257,43 @@ TEST(IntegratorAnalytic, NegativeMaxDepthIsRejected) {
     EXPECT_THROW(Renderer(s, rs), Error);
 }
 
+// Hall & Greenberg (1983) adaptive tree depth: two facing half-silvered mirrors, the upper one
+// also emitting e. Along the camera ray the branch weights are 0.5, 0.25, 0.125, ...; with
+// min_weight w only the branches whose weight is >= w are traced, so the pixel is the partial sum
+// of the geometric series e (0.5 + 0.125 + ...) and the reflection-ray count says where it stopped.
+TEST(IntegratorAnalytic, MinWeightCutsTheRayTreeWhereTheWeightFallsBelowIt) {
+    Scene s;
+    WhittedCoeffs lower;
+    lower.kr = Color(0.5f);
+    add_floor(s, add_classic_material(s, lower));
+    WhittedCoeffs upper = emitter(Color(1.f));
+    upper.kr = Color(0.5f);
+    add_mesh(s, make_quad({-10, -10, 10}, {-10, 10, 10}, {10, 10, 10}, {10, -10, 10}, add_classic_material(s, upper)));
+    s.cameras.push_back(top_down_ortho(1.0));
+    auto run = [&](float min_weight, uint64_t* reflections) {
+        RenderSettings rs;
+        rs.width = rs.height = 1;
+        rs.threads = 1;
+        rs.integrator.max_depth = 50;
+        rs.integrator.ambient = Color(0.f);
+        rs.integrator.min_weight = min_weight;
+        Renderer renderer(s, rs);
+        RenderStats stats;
+        Film film = renderer.render(&stats);
+        *reflections = stats.rays.reflection;
+        return film.beauty[0].x;
+    };
+    uint64_t refl = 0;
+    EXPECT_NEAR(run(0.6f, &refl), 0.f, 1e-6f);  // 0.5 < 0.6: not even the first bounce
+    EXPECT_EQ(refl, 0u);
+    EXPECT_NEAR(run(0.5f, &refl), 0.5f, 1e-6f);  // the first bounce only (weight exactly 0.5)
+    EXPECT_EQ(refl, 1u);
+    EXPECT_NEAR(run(0.1f, &refl), 0.5f + 0.125f, 1e-6f);  // weights 0.5, 0.25, 0.125
+    EXPECT_EQ(refl, 3u);
+    // No cutoff: the series converges to e * 0.5 / (1 - 0.25) = 2/3, ended by max_depth 50.
+    EXPECT_NEAR(run(0.f, &refl), 2.f / 3.f, 1e-5f);
+    EXPECT_EQ(refl, 50u);
+}
+
 }  // namespace
 }  // namespace whitted

@@ -2,6 +2,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -331,6 +333,79 @@ TEST(TextureTransform, OrderIsTranslateRotateScale) {
     const Vec2f b = apply_texture_transform(r, {1.f, 0.f});
     EXPECT_NEAR(b.x, 0.f, 1e-6f);
     EXPECT_NEAR(b.y, -2.f, 1e-6f);
+}
+
+// ---- procedural checker (scene files) ----
+
+
+Checker red_yellow(bool world) {
+    Checker c;
+    c.color_a = {1.f, 0.f, 0.f};
+    c.color_b = {1.f, 1.f, 0.f};
+    c.size = 0.5f;
+    c.world_space = world;
+    return c;
+}
+
+TEST(Checker, UvPointSamplesAlternate) {
+    const Checker c = red_yellow(false);
+    EXPECT_EQ(sample_checker(c, {0.1f, 0.1f}, {}, {}), c.color_a);   // cell (0, 0)
+    EXPECT_EQ(sample_checker(c, {0.6f, 0.1f}, {}, {}), c.color_b);   // cell (1, 0)
+    EXPECT_EQ(sample_checker(c, {0.6f, 0.6f}, {}, {}), c.color_a);   // cell (1, 1)
+    EXPECT_EQ(sample_checker(c, {-0.1f, 0.1f}, {}, {}), c.color_b);  // cell (-1, 0)
+    EXPECT_EQ(sample_checker(c, {-0.1f, -0.1f}, {}, {}), c.color_a); // cell (-1, -1)
+}
+
+TEST(Checker, WorldSpaceFloorOnCellBoundaryDoesNotFlicker) {
+    // A floor at y = 0 lies exactly on a cell boundary of the 3D checker; every point of it must
+    // pick the same y cell, so the pattern is a clean 2D checkerboard in x and z.
+    const Checker c = red_yellow(true);
+    const Vec3f up{0.f, 1.f, 0.f};
+    for (float y : {0.f, -0.f, 1e-9f, -1e-9f}) {
+        EXPECT_EQ(sample_checker(c, {}, {0.1f, y, 0.1f}, up), sample_checker(c, {}, {0.1f, 0.f, 0.1f}, up));
+        EXPECT_NE(sample_checker(c, {}, {0.6f, y, 0.1f}, up), sample_checker(c, {}, {0.1f, y, 0.1f}, up));
+        EXPECT_EQ(sample_checker(c, {}, {0.6f, y, 0.6f}, up), sample_checker(c, {}, {0.1f, y, 0.1f}, up));
+    }
+}
+
+TEST(Checker, BoxFilterMatchesNumericalAverage) {
+    // The closed-form filtered checker equals the average of point samples over the footprint
+    // square [u - w/2, u + w/2] x [v - w/2, v + w/2].
+    const Checker c = red_yellow(false);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> pos(-3.f, 3.f), width(0.01f, 0.9f);
+    for (int trial = 0; trial < 100; ++trial) {
+        const Vec2f uv{pos(rng), pos(rng)};
+        const float w = width(rng);
+        const int n = 400;
+        double green = 0.0;
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                const Vec2f q{uv.x + w * ((i + 0.5f) / n - 0.5f), uv.y + w * ((j + 0.5f) / n - 0.5f)};
+                green += sample_checker(c, q, {}, {}).y;
+            }
+        green /= double(n) * n;
+        EXPECT_NEAR(sample_checker(c, uv, {}, {}, w).y, green, 5e-3) << "uv " << uv.x << "," << uv.y << " w " << w;
+    }
+}
+
+TEST(Checker, WideFootprintGivesTheMean) {
+    const Checker c = red_yellow(false);
+    const Color mean = (c.color_a + c.color_b) * 0.5f;
+    EXPECT_EQ(sample_checker(c, {0.3f, 0.2f}, {}, {}, 5.f), mean);
+    // World space on a floor: the footprint lies in x and z, not across the y boundary.
+    const Checker w = red_yellow(true);
+    const Color far = sample_checker(w, {}, {0.3f, 0.f, 0.2f}, {0.f, 1.f, 0.f}, 5.f);
+    EXPECT_NEAR(far.y, mean.y, 1e-6f);
+}
+
+TEST(Checker, NonFiniteInputsGiveAFiniteColor) {
+    const Checker c = red_yellow(false);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_EQ(sample_checker(c, {nan, 0.f}, {}, {}), c.color_a);
+    EXPECT_EQ(sample_checker(c, {0.1f, 0.1f}, {}, {}, nan), c.color_a);
+    const Checker w = red_yellow(true);
+    EXPECT_EQ(sample_checker(w, {}, {kInfinity, 0.f, 0.f}, {0.f, 1.f, 0.f}), w.color_a);
 }
 
 }  // namespace
