@@ -33,6 +33,7 @@
 #include "importers/gltf_json.h"
 #include "importers/gltf_validation.h"
 #include "importers/image_decode.h"
+#include "importers/scene_defaults.h"
 #include "importers/scene_loader.h"
 #include "importers/warning_log.h"
 #include "importers/located_error.h"
@@ -47,11 +48,8 @@ namespace {
 using namespace gltf;
 
 // Documented in docs/lights.md and docs/gltf-support.md.
-constexpr size_t kMaxJsonDepth = 64;                                     ///< array/object nesting (docs/fuzzing.md)
-constexpr double kDefaultCameraYfov = 0.8;                               ///< radians (about 45.8 degrees)
-constexpr double kDefaultCameraMargin = 1.1;                             ///< bounding sphere fills 1/1.1 of the view
-constexpr float kDefaultLightIntensity = 1.f;                            ///< lux (renderer units, docs/lights.md)
-const Vec3d kDefaultLightDirection = normalize(Vec3d(0.4, -1.0, -0.6));  ///< travel direction
+constexpr size_t kMaxJsonDepth = 64;  ///< array/object nesting (docs/fuzzing.md)
+// The default camera and light are in scene_defaults.cpp (shared with the scene-file importer).
 
 // ---------------------------------------------------------------------------------------------
 // Reading the file
@@ -1173,56 +1171,7 @@ private:
     // ---- defaults -----------------------------------------------------------------------------
     void add_defaults() {
         if (m_scene.materials.empty()) default_material();
-        if (m_scene.cameras.empty() && m_options.add_default_camera) add_default_camera();
-        if (m_scene.lights.empty() && m_options.add_default_light) {
-            Light l;
-            l.name = "default light";
-            l.type = LightType::Directional;
-            l.color = Color(1.f);
-            l.intensity = kDefaultLightIntensity;
-            l.direction = kDefaultLightDirection;
-            l.attenuation = Attenuation::None;
-            l.is_default = true;
-            m_scene.lights.push_back(std::move(l));
-            m_warnings.add("default-light", "no lights in the file: added the default light (see docs/lights.md)");
-        }
-    }
-
-    /// Perspective camera on +Z, raised 15 degrees, looking at the bounds centre from far enough
-    /// that the bounding sphere fits the vertical field of view with a 10% margin.
-    void add_default_camera() {
-        const Bounds3d b = m_scene.world_bounds();
-        Vec3d center(0.0);
-        double radius = 1.0;
-        if (!b.empty()) {
-            center = b.center();
-            radius = 0.5 * length(b.diagonal());
-            if (!(radius > 0)) radius = 1.0;
-        }
-        const double distance = radius / std::sin(kDefaultCameraYfov / 2) * kDefaultCameraMargin;
-        const double elevation = 15.0 * std::numbers::pi / 180.0;
-        const Vec3d to_eye{0.0, std::sin(elevation), std::cos(elevation)};
-        const Vec3d eye = center + to_eye * distance;
-        // Camera frame: -Z looks at the centre, +X right, +Y up (glTF convention).
-        const Vec3d z = to_eye;
-        const Vec3d x = normalize(cross(Vec3d(0, 1, 0), z));
-        const Vec3d y = cross(z, x);
-        Camera c;
-        c.name = "default camera";
-        c.type = CameraType::Perspective;
-        c.yfov = kDefaultCameraYfov;
-        c.aspect = 0.0;
-        c.znear = std::max(1e-6, (distance - radius * kDefaultCameraMargin) * 0.1);
-        c.zfar = 0.0;
-        for (int r = 0; r < 3; ++r) {
-            c.world_from_camera(r, 0) = x[r];
-            c.world_from_camera(r, 1) = y[r];
-            c.world_from_camera(r, 2) = z[r];
-            c.world_from_camera(r, 3) = eye[r];
-        }
-        c.is_default = true;
-        m_scene.cameras.push_back(std::move(c));
-        m_warnings.add("default-camera", "no cameras in the scene: added a default camera framing the bounds");
+        add_scene_defaults(m_scene, m_options, m_warnings);  // camera, then light (scene_defaults.cpp)
     }
 
     const std::string m_path;

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "importers/located_error.h"
+#include "importers/scene_file.h"
 #include "renderer/core/error.h"
 
 namespace whitted {
@@ -14,9 +15,10 @@ Scene load_scene(const std::string& path, const ImportOptions& options) {
     std::string ext = std::filesystem::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
     if (ext == ".gltf" || ext == ".glb") return import_gltf(path, options);
+    if (ext == ".json") return import_scene_file(path, options);
     throw Error(file_loc(path),
-                ext.empty() ? std::string("file has no extension: cannot tell its format (supported: .gltf, .glb)")
-                            : "unsupported scene file extension '" + ext + "' (supported: .gltf, .glb)");
+                ext.empty() ? std::string("file has no extension: cannot tell its format (supported: .gltf, .glb, .json)")
+                            : "unsupported scene file extension '" + ext + "' (supported: .gltf, .glb, .json)");
 }
 
 }  // namespace whitted

@@ -21,7 +21,8 @@ struct ImportOptions {
                                                 ///< absolute and file:// URIs are refused either way
 };
 
-/// Loads a scene, dispatching on the extension (.gltf, .glb).
+/// Loads a scene, dispatching on the extension: .gltf, .glb (import_gltf), .json (the scene file,
+/// import_scene_file in importers/scene_file.h).
 Scene load_scene(const std::string& path, const ImportOptions& options = {});
 
 /// glTF 2.0 (.gltf with external or data-URI resources, .glb).

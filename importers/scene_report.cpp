@@ -96,6 +96,30 @@ std::string texture_slot(const char* slot, const TextureRef& ref, bool show_scal
     return s + ")";
 }
 
+/// " width=640 aa=adaptive ..." for the settings a scene file set, "" when none.
+std::string render_settings(const SceneRenderSettings& s) {
+    std::string out;
+    auto add = [&](const char* key, const std::string& value) { out += fmt::format(" {}={}", key, value); };
+    auto quoted = [](const std::string& v) { return "\"" + v + "\""; };
+    if (s.width) add("width", std::to_string(*s.width));
+    if (s.height) add("height", std::to_string(*s.height));
+    if (s.aa) add("aa", *s.aa);
+    if (s.aa_threshold) add("aa_threshold", num(*s.aa_threshold));
+    if (s.aa_depth) add("aa_depth", std::to_string(*s.aa_depth));
+    if (s.spp) add("spp", std::to_string(*s.spp));
+    if (s.max_depth) add("max_depth", std::to_string(*s.max_depth));
+    if (s.min_weight) add("min_weight", num(*s.min_weight));
+    if (s.background) add("background", vec3(*s.background));
+    if (s.ambient) add("ambient", vec3(*s.ambient));
+    if (s.exposure) add("exposure", num(*s.exposure));
+    if (s.fresnel) add("fresnel", yes_no(*s.fresnel));
+    if (s.output) add("output", quoted(*s.output));
+    if (s.view) add("view", quoted(*s.view));
+    if (s.display) add("display", quoted(*s.display));
+    if (s.camera) add("camera", std::to_string(*s.camera));
+    return out;
+}
+
 }  // namespace
 
 std::string describe_scene(const Scene& scene) {
@@ -107,16 +131,29 @@ std::string describe_scene(const Scene& scene) {
     line(fmt::format("file: {}", scene.source));
     line(
         fmt::format("counts: meshes={} triangles={} instanced_triangles={} instances={} spheres={} materials={} "
-                    "textures={} lights={} cameras={} warnings={}",
+                    "textures={} lights={} cameras={} planes={} warnings={}",
                     scene.meshes.size(), scene.mesh_triangle_count(), scene.instanced_triangle_count(),
                     scene.instances.size(), scene.spheres.size(), scene.materials.size(), scene.textures.size(),
-                    scene.lights.size(), scene.cameras.size(), scene.warnings.size()));
+                    scene.lights.size(), scene.cameras.size(), scene.planes.size(), scene.warnings.size()));
     const Bounds3d b = scene.world_bounds();
     if (b.empty())
         line("bounds: empty");
     else
         line(fmt::format("bounds: min={} max={} center={} diagonal={}", vec3(b.lo), vec3(b.hi), vec3(b.center()),
                          num(length(b.diagonal()))));
+    if (const std::string rs = render_settings(scene.settings); !rs.empty()) line("settings:" + rs);
+
+    // Analytic primitives (scene files).
+    for (size_t i = 0; i < scene.spheres.size(); ++i) {
+        const Sphere& sp = scene.spheres[i];
+        line(fmt::format("sphere[{}]: name=\"{}\" center={} radius={} material={}", i, sp.name, vec3(sp.center),
+                         num(sp.radius), sp.material));
+    }
+    for (size_t i = 0; i < scene.planes.size(); ++i) {
+        const Plane& pl = scene.planes[i];
+        line(fmt::format("plane[{}]: name=\"{}\" point={} normal={} u_axis={} material={} infinite=yes", i, pl.name,
+                         vec3(pl.point), vec3(pl.normal), vec3(pl.u_axis), pl.material));
+    }
 
     for (size_t i = 0; i < scene.lights.size(); ++i) {
         const Light& l = scene.lights[i];
@@ -176,12 +213,19 @@ std::string describe_scene(const Scene& scene) {
                                 texture_slot("emissive", m.emissive_texture, false) +
                                 texture_slot("transmission", m.transmission_texture, false) +
                                 texture_slot("specular", m.specular_texture, false) +
-                                texture_slot("specular_color", m.specular_color_texture, false);
+                                texture_slot("specular_color", m.specular_color_texture, false) +
+                                texture_slot("classic_color", m.classic_color_texture, false);
         line(fmt::format("material[{}] textures:{}", i, tex.empty() ? " none" : tex));
     }
 
     for (size_t i = 0; i < scene.textures.size(); ++i) {
         const Texture& t = scene.textures[i];
+        if (t.kind == TextureKind::Checker) {
+            line(fmt::format("texture[{}]: name=\"{}\" kind=checker color_a={} color_b={} size={} space={}", i, t.name,
+                             vec3(t.checker.color_a), vec3(t.checker.color_b), num(t.checker.size),
+                             t.checker.world_space ? "world" : "uv"));
+            continue;
+        }
         const std::string size =
             t.levels.empty() ? std::string("not-loaded") : fmt::format("{}x{}", t.levels[0].width, t.levels[0].height);
         line(fmt::format("texture[{}]: name=\"{}\" size={} levels={} srgb={} wrap={}/{} filter={}/{} mips={} image={}",

@@ -7,8 +7,9 @@
 
 namespace whitted {
 
-/// Multi-line report: counts, bounds, lights, cameras, materials (glTF inputs and the mapped
-/// Whitted coefficients), textures, extensions and warnings. One `key: ...` record per line with
+/// Multi-line report: counts, bounds, scene-file render settings, spheres, infinite planes, lights,
+/// cameras, materials (glTF inputs or classic, and the Whitted coefficients), textures (images and
+/// procedural checkers), extensions and warnings. One `key: ...` record per line with
 /// `name=value` fields, stable across runs, so it can be grepped and diffed.
 std::string describe_scene(const Scene& scene);
 

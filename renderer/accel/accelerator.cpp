@@ -5,10 +5,12 @@
 #include <vector>
 
 #include "renderer/accel/bvh/bvh_accel.h"
+#include "renderer/accel/common/planes.h"
 #include "renderer/accel/embree/embree_accel.h"
 #include "renderer/accel/grid/grid_accel.h"
 #include "renderer/accel/octree/octree_accel.h"
 #include "renderer/core/error.h"
+#include "renderer/scene/scene.h"
 
 namespace whitted {
 
@@ -89,10 +91,12 @@ const std::vector<std::string>& accelerator_names() {
     return names;
 }
 
-std::unique_ptr<Accelerator> create_accelerator(const std::string& name, const Scene& scene,
-                                                const SurfaceFilter& filter, const AccelConfig& config) {
+namespace {
+
+/// The backend alone, without the scene's infinite planes.
+std::unique_ptr<Accelerator> create_backend(const std::string& name, const Scene& scene, const SurfaceFilter& filter,
+                                            const AccelConfig& config) {
     AccelSpec spec(name);
-    std::unique_ptr<Accelerator> accel;
     if (spec.name() == "embree") {
         spec.check_all_used("none");
         return create_embree_accelerator(scene, filter, EmbreeConfig{config.robust, config.threads});
@@ -136,6 +140,16 @@ std::unique_ptr<Accelerator> create_accelerator(const std::string& name, const S
         return create_octree_accelerator(scene, filter, c);
     }
     throw Error(fmt::format("unknown accelerator '{}' (available: embree, bvh, grid, octree, kdop, brute)", spec.name()));
+}
+
+}  // namespace
+
+std::unique_ptr<Accelerator> create_accelerator(const std::string& name, const Scene& scene,
+                                                const SurfaceFilter& filter, const AccelConfig& config) {
+    std::unique_ptr<Accelerator> accel = create_backend(name, scene, filter, config);
+    // Infinite planes stay out of every structure and are tested beside it (planes.h).
+    if (!scene.planes.empty()) accel = std::make_unique<PlaneDecorator>(std::move(accel), scene, filter);
+    return accel;
 }
 
 }  // namespace whitted

@@ -12,7 +12,12 @@
 //
 // Surface decisions that need materials (alpha-mask cut-outs, back-face culling of camera rays,
 // the transmittance of a transparent surface) are asked of a SurfaceFilter the caller provides,
-// so backends never look at materials or textures themselves.
+// so backends never look at materials or textures themselves. The filter is consulted in the
+// same way for every kind of geometry (meshes, spheres, planes), by geometry id.
+//
+// Every backend handles Scene::spheres (analytic, in its own structure or as Embree user
+// geometry) and Scene::planes (infinite, tested beside the structure by a decorator that
+// create_accelerator adds; see docs/accelerators.md).
 #pragma once
 
 #include <cstdint>
@@ -39,9 +44,11 @@ struct Ray {
 
 constexpr uint32_t kInvalidId = std::numeric_limits<uint32_t>::max();
 
-/// Minimal hit record. geom indexes Scene::meshes (triangles) or, for analytic primitives,
-/// Scene::spheres offset by Scene::meshes.size(); inst indexes Scene::instances (kInvalidId for
-/// primitives that are not instanced). u, v are barycentrics of vertices 1 and 2.
+/// Minimal hit record. geom is a geometry id (Scene::geom_kind): a mesh index, or for analytic
+/// primitives Scene::sphere_geom_id(i) / Scene::plane_geom_id(i); inst indexes Scene::instances
+/// (kInvalidId for spheres and planes, which are not instanced). For triangles prim is the
+/// triangle and u, v are the barycentrics of vertices 1 and 2; for spheres and planes prim = 0
+/// and u = v = 0 (shading computes their UVs from the hit point).
 struct Hit {
     float t = kInfinity;
     float u = 0.f, v = 0.f;
@@ -57,13 +64,15 @@ public:
     virtual ~SurfaceFilter() = default;
     /// True when a candidate hit counts for a closest-hit query of this kind (alpha MASK
     /// cut-outs return false everywhere; camera rays also reject back faces of single-sided
-    /// materials).
+    /// materials). `ray` is the caller's ray, except that its tfar may have been shortened to a
+    /// nearer plane hit already accepted.
     virtual bool accept(const Ray& ray, const Hit& hit, RayKind kind) const = 0;
     /// Fraction of light a surface crossing lets through, per channel: 0 for opaque surfaces,
     /// 1 where an alpha mask cuts the surface away, Kt (or 1 - alpha for BLEND) otherwise.
     virtual Color transmittance(const Ray& ray, const Hit& hit) const = 0;
-    /// What mesh `geom` needs from traversal: a combination of the SurfaceFilter::k* flags.
-    /// Backends skip the filter calls a mesh does not need (a plain opaque mesh needs none).
+    /// What geometry `geom` (mesh, sphere or plane id) needs from traversal: a combination of the
+    /// SurfaceFilter::k* flags. Backends skip the filter calls a geometry does not need (a plain
+    /// opaque one needs none). The name predates spheres and planes.
     virtual uint32_t mesh_flags(uint32_t geom) const = 0;
 
     static constexpr uint32_t kNeedsAccept = 1u;         ///< call accept() on closest-hit candidates

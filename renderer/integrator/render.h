@@ -72,6 +72,11 @@ private:
     double m_build_seconds = 0.0;
 };
 
+/// Copies the render settings a scene file carries (size, camera, anti-aliasing, depth, min
+/// weight, background, ambient, exposure in stops, Fresnel) into `rs`; unset values leave `rs` as
+/// it is. Output, OCIO view and display belong to the output stage and are not touched.
+void apply_scene_settings(const SceneRenderSettings& s, RenderSettings& rs);
+
 /// Parses "x0,y0,x1,y1" (pixels, x1/y1 exclusive); throws whitted::Error when malformed.
 PixelWindow parse_crop(const std::string& text);
 

@@ -10,6 +10,7 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -30,6 +31,7 @@ struct ImageCase {
     int height = 0;
     int camera = 0;
     bool refract_thin = false;
+    bool scene_settings = false;  ///< a scene file: apply its render settings, then the size above
 };
 
 std::ostream& operator<<(std::ostream& os, const ImageCase& c) { return os << c.name; }
@@ -54,8 +56,11 @@ OIIO::ImageBuf to_imagebuf(const Film& film) {
 Film render_case(const ImageCase& c) {
     Scene scene = load_scene(std::string(WHITTED_ASSETS_DIR) + "/" + c.asset);
     RenderSettings rs;
+    if (c.scene_settings) apply_scene_settings(scene.settings, rs);
     rs.width = c.width;
     rs.height = c.height;
+    if (c.scene_settings && c.height == 0 && scene.settings.width && scene.settings.height)
+        rs.height = int(std::lround(double(c.width) * *scene.settings.height / *scene.settings.width));
     rs.camera = c.camera;
     rs.mapping.refract_thin = c.refract_thin;
     return Renderer(scene, rs).render();
@@ -104,7 +109,10 @@ INSTANTIATE_TEST_SUITE_P(
                       ImageCase{"duck", "gltf/Duck/glTF-Binary/Duck.glb"},
                       ImageCase{"lamp", "gltf/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf"},
                       ImageCase{"hurricane", "gltf/GlassHurricaneCandleHolder/glTF-Binary/GlassHurricaneCandleHolder.glb"},
-                      ImageCase{"default_scene", "scenes/default.glb"}),
+                      ImageCase{"default_scene", "scenes/default.glb"},
+                      ImageCase{"whitted1980", "scenes/whitted1980.json", 160, 0, 0, false, true},
+                      ImageCase{"transparent_shadows", "scenes/transparent_shadows.json", 160, 0, 0, false, true},
+                      ImageCase{"glass_mirror_room", "scenes/glass_mirror_room.json", 160, 0, 0, false, true}),
     [](const ::testing::TestParamInfo<ImageCase>& info) { return info.param.name; });
 
 }  // namespace

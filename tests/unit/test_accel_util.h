@@ -40,6 +40,66 @@ public:
     }
 };
 
+/// Filter over every kind of geometry (ids as in Scene: meshes, spheres, planes), with answers
+/// a test can predict. Meshes follow PatternFilter. Spheres by index % 4: 0 opaque;
+/// 1 transparent (Kt depends on the sphere); 2 cut away entirely (accept() false, transmittance
+/// 1); 3 the entering side cut away (accept() only where the ray leaves the sphere; transmittance
+/// 1 on entering, Kt 0.6 on leaving). Planes by index % 3: 0 opaque; 1 transparent; 2 a checker
+/// cut-out of 0.7-unit squares in the plane's (u_axis, normal x u_axis) frame.
+class MixedFilter final : public SurfaceFilter {
+public:
+    explicit MixedFilter(const Scene& s) : m_meshes(uint32_t(s.meshes.size())), m_spheres(s.spheres), m_planes(s.planes) {}
+
+    bool accept(const Ray& r, const Hit& h, RayKind k) const override {
+        if (h.geom < m_meshes) return m_pattern.accept(r, h, k);
+        if (const Sphere* sp = sphere(h.geom)) return sphere_index(h.geom) % 4 == 3 ? leaving(r, h, *sp) : false;
+        return plane_checker(r, h);
+    }
+    Color transmittance(const Ray& r, const Hit& h) const override {
+        if (h.geom < m_meshes) return m_pattern.transmittance(r, h);
+        if (const Sphere* sp = sphere(h.geom)) {
+            switch (sphere_index(h.geom) % 4) {
+                case 1: return Color(0.9f, 0.7f - 0.02f * float(sphere_index(h.geom) % 9), 0.8f);
+                case 2: return Color(1.f);
+                case 3: return leaving(r, h, *sp) ? Color(0.6f) : Color(1.f);
+                default: return Color(0.f);
+            }
+        }
+        const uint32_t i = plane_index(h.geom);
+        if (i % 3 == 1) return Color(0.75f, 0.5f, 0.95f);
+        return i % 3 == 2 && !plane_checker(r, h) ? Color(1.f) : Color(0.f);
+    }
+    uint32_t mesh_flags(uint32_t g) const override {
+        if (g < m_meshes) return m_pattern.mesh_flags(g);
+        if (sphere(g)) {
+            const uint32_t i = sphere_index(g) % 4;
+            return i == 0 ? 0u : i == 1 ? kNeedsTransmittance : kNeedsAccept | kNeedsTransmittance;
+        }
+        const uint32_t i = plane_index(g) % 3;
+        return i == 0 ? 0u : i == 1 ? kNeedsTransmittance : kNeedsAccept | kNeedsTransmittance;
+    }
+
+private:
+    uint32_t sphere_index(uint32_t g) const { return g - m_meshes; }
+    uint32_t plane_index(uint32_t g) const { return g - m_meshes - uint32_t(m_spheres.size()); }
+    const Sphere* sphere(uint32_t g) const { return g - m_meshes < m_spheres.size() ? &m_spheres[g - m_meshes] : nullptr; }
+    static bool leaving(const Ray& r, const Hit& h, const Sphere& s) {
+        const Vec3d p = Vec3d(r.org) + Vec3d(r.dir) * double(h.t);
+        return dot(p - s.center, Vec3d(r.dir)) > 0.0;
+    }
+    bool plane_checker(const Ray& r, const Hit& h) const {
+        const Plane& pl = m_planes[plane_index(h.geom)];
+        const Vec3d p = Vec3d(r.org) + Vec3d(r.dir) * double(h.t) - pl.point;
+        const double u = dot(p, pl.u_axis) / 0.7, v = dot(p, cross(pl.normal, pl.u_axis)) / 0.7;
+        return (int64_t(std::floor(u)) + int64_t(std::floor(v))) % 2 == 0;
+    }
+
+    PatternFilter m_pattern;
+    uint32_t m_meshes;
+    std::vector<Sphere> m_spheres;
+    std::vector<Plane> m_planes;
+};
+
 inline Mesh make_uv_sphere(Vec3f c, float r, int rings, int segments) {
     Mesh m;
     m.name = "sphere";
@@ -161,6 +221,47 @@ inline std::vector<Ray> make_rays(const Scene& s, uint32_t count, uint32_t seed)
         if (i & 8) r.dir[(axis + 1) % 3] = -0.f;
         rays.push_back(r);
     }
+    return rays;
+}
+
+/// Edge cases of analytic geometry: for each sphere, rays from its centre, from points on its
+/// surface (inwards and outwards), tangent to it and aimed at its centre from outside; for each
+/// plane, rays lying in it, parallel to it (with +0 and -0 components along the normal when the
+/// normal is an axis) and starting on it.
+inline std::vector<Ray> make_analytic_rays(const Scene& s, uint32_t per_primitive, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> gauss;
+    auto unit = [&] { return normalize(Vec3d(gauss(rng), gauss(rng), gauss(rng))); };
+    std::vector<Ray> rays;
+    auto add = [&](Vec3d o, Vec3d d) {
+        Ray r;
+        r.org = Vec3f(o);
+        r.dir = Vec3f(d);
+        rays.push_back(r);
+    };
+    for (const Sphere& sp : s.spheres)
+        for (uint32_t i = 0; i < per_primitive; ++i) {
+            const Vec3d n = unit(), d = unit(), side = normalize(cross(n, unit()));
+            add(sp.center, d);                                              // from the centre
+            add(sp.center + n * sp.radius, dot(d, n) < 0 ? d : -d);           // on the surface, inwards
+            add(sp.center + n * sp.radius, dot(d, n) > 0 ? d : -d);           // on the surface, outwards
+            add(sp.center + side * sp.radius - n * (3 * sp.radius), n);       // tangent
+            add(sp.center + n * (4 * sp.radius + 1), -n);                     // at the centre
+        }
+    for (const Plane& pl : s.planes)
+        for (uint32_t i = 0; i < per_primitive; ++i) {
+            const Vec3d v = cross(pl.normal, pl.u_axis);
+            const Vec3d in_plane = pl.u_axis * gauss(rng) + v * gauss(rng);
+            const Vec3d on = pl.point + pl.u_axis * (3 * gauss(rng)) + v * (3 * gauss(rng));
+            add(on, in_plane);                                                // lying in the plane
+            Ray r;
+            r.org = Vec3f(on + pl.normal * (0.5 * gauss(rng)));
+            r.dir = Vec3f(in_plane);
+            for (int k = 0; k < 3; ++k)
+                if (std::fabs(pl.normal[k]) == 1.0) r.dir[k] = (i & 1) ? -0.f : 0.f;  // exactly parallel, +-0
+            rays.push_back(r);
+            add(on, unit());                                                  // starting on it
+        }
     return rays;
 }
 

@@ -39,13 +39,15 @@ struct BruteForceConfig {
     Precision precision = Precision::Float;      ///< double = ground truth for float error
 };
 
-/// Two-level SAH BVH (BLAS per mesh, TLAS over instances), watertight triangle test.
+/// Two-level SAH BVH (BLAS per mesh, TLAS over instances, one more BVH over the spheres),
+/// watertight triangle test, stable sphere test (common/sphere.h).
 std::unique_ptr<Accelerator> create_bvh_accelerator(const Scene& scene, const SurfaceFilter& filter,
                                                     const BvhConfig& config);
-/// Two-level BVH whose nodes are k-DOPs (Kay & Kajiya 1986).
+/// Two-level BVH whose nodes are k-DOPs (Kay & Kajiya 1986), spheres likewise.
 std::unique_ptr<Accelerator> create_kdop_accelerator(const Scene& scene, const SurfaceFilter& filter,
                                                      const KdopConfig& config);
-/// Tests every triangle of every instance: O(n) per ray, the oracle the others are checked against.
+/// Tests every triangle of every instance and every sphere: O(n) per ray, the oracle the others
+/// are checked against.
 std::unique_ptr<Accelerator> create_brute_force_accelerator(const Scene& scene, const SurfaceFilter& filter,
                                                             const BruteForceConfig& config);
 

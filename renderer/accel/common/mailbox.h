@@ -1,4 +1,4 @@
-// Mailbox for structures that reference a triangle from several cells (grid, octree): a small
+// Mailbox for structures that reference a primitive from several cells (grid, octree): a small
 // direct-mapped cache, per ray, of the triangles already tested (Amanatides & Woo 1987 keep a ray
 // id per primitive; that is not thread-safe for a const structure shared by all threads, so the
 // mailbox lives on the ray's stack instead). A collision only costs a repeated test.
@@ -9,7 +9,7 @@
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/accel/common/geometry.h"
-#include "renderer/accel/common/two_level.h"
+#include "renderer/accel/common/primitives.h"
 
 namespace whitted {
 
@@ -32,20 +32,17 @@ private:
     uint32_t m_prims[kSize];
 };
 
-/// Tests the triangles refs[begin, end) that the mailbox has not seen yet against the query `q`
-/// (its tmax shrinks as hits are reported); true when the query asks to stop (any-hit answered).
-/// The leaf loop shared by the grid's cells and the octree's leaves.
-template <typename Query>
-inline bool test_mailboxed_refs(const std::vector<uint32_t>& refs, uint32_t begin, uint32_t end,
-                                const std::vector<TriangleVerts<float>>& tris, Mailbox& mailbox,
-                                const WatertightRay<float>& wr, float tnear, Query& q) {
+/// Tests the primitives refs[begin, end) of the set `prims` (primitives.h) that the mailbox has
+/// not seen yet against the query `q` (its tmax shrinks as hits are reported); true when the
+/// query asks to stop (any-hit answered). The leaf loop shared by the grid's cells and the
+/// octree's leaves.
+template <typename P, typename Query>
+inline bool test_mailboxed_refs(const std::vector<uint32_t>& refs, uint32_t begin, uint32_t end, const P& prims,
+                                Mailbox& mailbox, const typename P::RayData& ray, float tnear, Query& q) {
     for (uint32_t r = begin; r < end; ++r) {
         const uint32_t prim = refs[r];
         if (mailbox.seen(prim)) continue;
-        const TriangleVerts<float>& tri = tris[prim];
-        float t, u, v;
-        if (intersect_triangle(wr, tri.p0, tri.p1, tri.p2, tnear, q.tmax, t, u, v) && q.report(t, u, v, prim))
-            return true;
+        if (prims.intersect(ray, prim, prim, tnear, q)) return true;
     }
     return false;
 }

@@ -4,9 +4,12 @@
 //   - ClosestQuery keeps the nearest accepted hit; accept() is asked only for meshes whose
 //     mesh_flags() has kNeedsAccept.
 //   - ShadowQuery stops at the first crossing of a mesh without filter flags (opaque), otherwise
-//     collects the crossings; resolve() sorts them by t, removes duplicates per (geom, inst)
-//     within 64 ulps of t (Embree's rule) and multiplies their transmittances. Sorting makes the
-//     product independent of traversal order.
+//     collects the crossings; resolve() sorts them by t, removes duplicates per (geom, inst,
+//     part) within 64 ulps of t (Embree's rule) and multiplies their transmittances. Sorting
+//     makes the product independent of traversal order.
+// A report's `part` tells the two crossings of one analytic sphere apart (0 = entering root,
+// 1 = leaving root), so that a small transparent sphere far away counts twice even when both of
+// its roots fall within the de-duplication window; triangles always report part 0.
 #pragma once
 
 #include <algorithm>
@@ -22,7 +25,8 @@ namespace whitted {
 /// the Embree backend).
 constexpr float kDedupUlps = 64.f;
 
-/// The instance a traversal is currently inside, with its filter needs.
+/// The instance a traversal is currently inside, with its filter needs (for spheres: the sphere
+/// being tested, inst = kInvalidId).
 struct InstanceContext {
     uint32_t geom = kInvalidId;
     uint32_t inst = kInvalidId;
@@ -42,8 +46,8 @@ struct ClosestQuery {
 
     ClosestQuery(const SurfaceFilter& f, const Ray& r, RayKind k) : filter(f), ray(r), kind(k), tmax(T(r.tfar)) {}
 
-    /// A triangle hit with tnear < t <= tmax. Returns true to end the whole traversal (never).
-    bool report(T t, T u, T v, uint32_t prim) {
+    /// A hit with tnear < t <= tmax. Returns true to end the whole traversal (never).
+    bool report(T t, T u, T v, uint32_t prim, uint8_t /*part*/ = 0) {
         Hit h;
         h.t = float(t);
         h.u = float(u);
@@ -62,6 +66,7 @@ struct ClosestQuery {
 struct Crossing {
     float t, u, v;
     uint32_t prim, geom, inst;
+    uint8_t part;  ///< which root of a sphere (0 for triangles and planes)
 };
 
 /// Transmittance query: all crossings in (tnear, tfar].
@@ -80,13 +85,13 @@ struct ShadowQuery {
         crossings.clear();
     }
 
-    /// A triangle hit with tnear < t <= tfar. Returns true once an opaque surface ends the query.
-    bool report(T t, T u, T v, uint32_t prim) {
+    /// A hit with tnear < t <= tfar. Returns true once an opaque surface ends the query.
+    bool report(T t, T u, T v, uint32_t prim, uint8_t part = 0) {
         if (!(ctx.flags & (SurfaceFilter::kNeedsTransmittance | SurfaceFilter::kNeedsAccept))) {
             blocked = true;
             return true;
         }
-        crossings.push_back({float(t), float(u), float(v), prim, ctx.geom, ctx.inst});
+        crossings.push_back({float(t), float(u), float(v), prim, ctx.geom, ctx.inst, part});
         return false;
     }
 
@@ -97,6 +102,7 @@ struct ShadowQuery {
             if (a.t != b.t) return a.t < b.t;
             if (a.geom != b.geom) return a.geom < b.geom;
             if (a.inst != b.inst) return a.inst < b.inst;
+            if (a.part != b.part) return a.part < b.part;
             return a.prim < b.prim;
         });
         Color tr(1.f);
@@ -107,7 +113,7 @@ struct ShadowQuery {
             bool duplicate = false;
             for (size_t k = 0; k < kept; ++k) {
                 const Crossing& s = crossings[k];
-                if (s.geom == c.geom && s.inst == c.inst && std::fabs(s.t - c.t) <= window) {
+                if (s.geom == c.geom && s.inst == c.inst && s.part == c.part && std::fabs(s.t - c.t) <= window) {
                     duplicate = true;
                     break;
                 }

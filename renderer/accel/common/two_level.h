@@ -2,12 +2,14 @@
 // one bottom-level structure (BLAS) per mesh in object space, and a top level over the instances
 // that transforms the ray into each instance's object space (t is unchanged by an affine map of
 // origin and direction). The top level is a SAH BVH over the instances' world boxes, or, for the
-// brute-force oracle, a plain loop.
+// brute-force oracle, a plain loop. The scene's analytic spheres are one more structure of the
+// backend's own kind (SphereBlas, built over SpherePrims in world space), traced beside the top
+// level with the world-space ray; infinite planes are added outside (planes.h).
 //
 // A BLAS type provides
 //   template <class Query> bool traverse(const Vec3<T>& org, const Vec3<T>& dir, T tnear, Query& q) const;
-//     reports every candidate triangle hit in (tnear, q.tmax] to q.report(t, u, v, prim) and
-//     returns true as soon as report() does;
+//     reports every candidate hit in (tnear, q.tmax] to q.report(...) and returns true as soon
+//     as report() does;
 //   Bounds3<T> bounds() const; BlasStats stats() const.
 #pragma once
 
@@ -22,6 +24,7 @@
 #include "renderer/accel/accelerator.h"
 #include "renderer/accel/bvh/bvh_tree.h"
 #include "renderer/accel/common/geometry.h"
+#include "renderer/accel/common/primitives.h"
 #include "renderer/accel/common/queries.h"
 #include "renderer/scene/scene.h"
 
@@ -34,33 +37,6 @@ struct BlasStats {
     size_t references = 0;   ///< primitive references (> triangles when cells duplicate them)
     double sah_cost = 0.0;   ///< SAH cost of the tree (0 when it does not apply), area-weighted by triangles
 };
-
-/// A triangle's three vertices in the precision T.
-template <typename T>
-struct TriangleVerts {
-    Vec3<T> p0, p1, p2;
-};
-
-/// Object-space triangles of a mesh (index order), degenerate index ranges already validated by
-/// the importer.
-template <typename T>
-std::vector<TriangleVerts<T>> mesh_triangles(const Mesh& mesh) {
-    std::vector<TriangleVerts<T>> tris(mesh.triangle_count());
-    for (size_t i = 0; i < tris.size(); ++i) {
-        tris[i] = {Vec3<T>(mesh.positions[mesh.indices[3 * i]]), Vec3<T>(mesh.positions[mesh.indices[3 * i + 1]]),
-                   Vec3<T>(mesh.positions[mesh.indices[3 * i + 2]])};
-    }
-    return tris;
-}
-
-template <typename T>
-Bounds3<T> triangle_bounds(const TriangleVerts<T>& t) {
-    Bounds3<T> b;
-    b.extend(t.p0);
-    b.extend(t.p1);
-    b.extend(t.p2);
-    return b;
-}
 
 /// Row-major 3x4 affine transform in precision T.
 template <typename T>
@@ -82,18 +58,24 @@ struct Affine {
     }
 };
 
-/// The accelerator built from one BLAS per mesh and a top level over instances.
-template <typename T, typename Blas>
+/// The accelerator built from one BLAS per mesh, a top level over instances and one structure
+/// over the scene's spheres.
+template <typename T, typename Blas, typename SphereBlas>
 class TwoLevelAccelerator final : public Accelerator {
 public:
     using BlasBuilder = std::function<Blas(const Mesh&)>;
+    using SphereBuilder = std::function<SphereBlas(SpherePrims<T>&&)>;
 
     /// Builds the BLASes in parallel over meshes (each build is deterministic), then the top
-    /// level. `bvh_top` false = loop over all instances (the brute-force oracle).
+    /// level and the sphere structure (when the scene has spheres). `bvh_top` false = loop over
+    /// all instances (the brute-force oracle).
     TwoLevelAccelerator(std::string name, const Scene& scene, const SurfaceFilter& filter, const BlasBuilder& build_blas,
-                        bool bvh_top)
+                        const SphereBuilder& build_spheres, bool bvh_top)
         : m_name(std::move(name)), m_filter(filter), m_bvh_top(bvh_top) {
         const auto start = std::chrono::steady_clock::now();
+        // Spheres: world space, each with its own geometry id and filter flags.
+        SpherePrims<T> spheres(scene, filter);
+        if (spheres.size() > 0) m_spheres = std::make_unique<SphereBlas>(build_spheres(std::move(spheres)));
         // Bottom level: one structure per mesh that has triangles.
         m_blas.resize(scene.meshes.size());
         tbb::parallel_for(size_t(0), scene.meshes.size(), [&](size_t m) {
@@ -131,6 +113,12 @@ public:
             tris += scene.meshes[m].triangle_count();
         }
         m_stats.sah_cost = tris ? sah_weighted / double(tris) : 0.0;
+        if (m_spheres) {
+            const BlasStats s = m_spheres->stats();
+            m_stats.bytes += s.bytes;
+            m_stats.nodes += s.nodes;
+            m_stats.references += s.references;
+        }
         m_stats.bytes += m_top.size() * sizeof(m_top[0]) + m_top_ids.size() * 4 + m_instances.size() * sizeof(InstanceData);
         m_stats.nodes += m_top.size();
     }
@@ -183,6 +171,8 @@ private:
         if (!ray_is_traceable(ray)) return;
         const Vec3<T> org(ray.org), dir(ray.dir);
         const T tnear = T(ray.tnear);
+        // Spheres first (world space; they set q.ctx per sphere).
+        if (m_spheres && m_spheres->traverse(org, dir, tnear, q)) return;
         // Enter one instance: object-space ray, then its BLAS.
         auto visit = [&](const InstanceData& d) -> bool {
             q.ctx = InstanceContext{d.mesh, d.inst, d.flags};
@@ -207,6 +197,7 @@ private:
     const SurfaceFilter& m_filter;
     bool m_bvh_top = true;
     std::vector<std::unique_ptr<Blas>> m_blas;
+    std::unique_ptr<SphereBlas> m_spheres;   ///< null when the scene has no (valid) spheres
     std::vector<InstanceData> m_instances;
     std::vector<BvhNode<AabbVolume<T>>> m_top;
     std::vector<uint32_t> m_top_ids;

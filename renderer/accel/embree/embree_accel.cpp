@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "renderer/accel/common/geometry.h"
+#include "renderer/accel/common/primitives.h"
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
 #include "renderer/scene/scene.h"
@@ -50,13 +51,14 @@ constexpr size_t kVertexPadding = 16;
 /// crossings de-duplication stops (the product is still taken; documented limit).
 constexpr int kMaxSeen = 64;
 
-/// Two candidate hits of one (mesh, instance) closer than this many ulps of t are one crossing:
-/// Embree may report a primitive twice (spatial splits) and both triangles at a shared edge.
-constexpr float kDedupUlps = 64.f;
+// Two candidate hits of one (mesh, instance) closer than kDedupUlps (queries.h, shared with the
+// in-house backends) ulps of t are one crossing: Embree may report a primitive twice (spatial
+// splits) and both triangles at a shared edge.
 
 struct SeenCrossing {
     uint32_t geom, inst;
     float t;
+    uint8_t part;  ///< which root of a sphere (0 for triangles)
 };
 
 /// RTCIntersectContext extended with what our filter functions need (Embree passes the context
@@ -93,35 +95,119 @@ void intersect_filter(const RTCFilterFunctionNArguments* args) {
     }
 }
 
+/// One candidate crossing of a shadow ray, in traversal order: multiplies its transmittance
+/// unless the same surface was already counted (per (geom, inst, part) within kDedupUlps of t).
+/// Returns true once nothing passes any more (the ray is blocked).
+bool add_crossing(QueryContext& q, const Hit& h, uint8_t part) {
+    const float window = kDedupUlps * (std::nextafter(std::fabs(h.t), kInfinity) - std::fabs(h.t));
+    for (int k = 0; k < q.seen_count; ++k) {
+        const SeenCrossing& s = q.seen[k];
+        if (s.geom == h.geom && s.inst == h.inst && s.part == part && std::fabs(s.t - h.t) <= window) return false;
+    }
+    const Color tr = q.filter->transmittance(*q.ray, h);
+    if (q.seen_count < kMaxSeen) q.seen[q.seen_count++] = {h.geom, h.inst, h.t, part};
+    q.transmittance *= tr;
+    if (!is_black(q.transmittance)) return false;
+    q.transmittance = Color(0.f);
+    return true;
+}
+
 /// Shadow filter: multiplies the transmittance of each distinct crossing and rejects the hit
 /// so traversal continues; accepts (terminating the query) once nothing passes.
 void occluded_filter(const RTCFilterFunctionNArguments* args) {
     auto& q = *reinterpret_cast<QueryContext*>(args->context);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
-        Hit h = hit_from_filter_args(args, i, q);
-        // Count each surface crossing once.
-        float window = kDedupUlps * (std::nextafter(std::fabs(h.t), kInfinity) - std::fabs(h.t));
-        bool duplicate = false;
-        for (int k = 0; k < q.seen_count; ++k) {
-            const SeenCrossing& s = q.seen[k];
-            if (s.geom == h.geom && s.inst == h.inst && std::fabs(s.t - h.t) <= window) {
-                duplicate = true;
+        // Keep the hit (the ray is blocked, traversal stops) only once nothing passes.
+        if (!add_crossing(q, hit_from_filter_args(args, i, q), 0)) args->valid[i] = 0;
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The scene's spheres as one RTC_GEOMETRY_TYPE_USER geometry in the top-level scene (primitive i
+// = SpherePrims item i). Embree runs no filter functions for user geometry, so the callbacks
+// apply the same rules as the triangle filters above: accept() for kNeedsAccept, and for shadow
+// rays add_crossing() for both roots, or blocked at once for an opaque sphere. The roots come
+// from the in-house kernel (sphere_roots<float>), so t is the float `bvh` backend's t.
+
+Hit sphere_hit(const SpherePrims<float>::Item& s, float t) {
+    Hit h;
+    h.t = t;
+    h.prim = 0;
+    h.geom = s.geom;
+    h.inst = kInvalidId;
+    return h;
+}
+
+void sphere_bounds_fn(const RTCBoundsFunctionArguments* args) {
+    const auto& spheres = *static_cast<const SpherePrims<float>*>(args->geometryUserPtr);
+    const Bounds3f b = spheres.bounds(args->primID);
+    args->bounds_o->lower_x = b.lo.x;
+    args->bounds_o->lower_y = b.lo.y;
+    args->bounds_o->lower_z = b.lo.z;
+    args->bounds_o->upper_x = b.hi.x;
+    args->bounds_o->upper_y = b.hi.y;
+    args->bounds_o->upper_z = b.hi.z;
+}
+
+/// The roots of ray i of a ray packet against sphere `s`.
+bool packet_sphere_roots(RTCRayN* ray, unsigned n, unsigned i, const SpherePrims<float>::Item& s, float& t0,
+                         float& t1) {
+    const Vec3f org{RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i), RTCRayN_org_z(ray, n, i)};
+    const Vec3f dir{RTCRayN_dir_x(ray, n, i), RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i)};
+    return sphere_roots(org, dir, s.center, s.radius, t0, t1);
+}
+
+/// Closest hit: the nearer root in (tnear, tfar] that accept() takes, else the farther one.
+void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
+    const auto& spheres = *static_cast<const SpherePrims<float>*>(args->geometryUserPtr);
+    const auto& q = *reinterpret_cast<const QueryContext*>(args->context);
+    const SpherePrims<float>::Item& s = spheres.item(args->primID);
+    RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, args->N);
+    RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, args->N);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        float roots[2];
+        if (!packet_sphere_roots(ray, args->N, i, s, roots[0], roots[1])) continue;
+        const float tnear = RTCRayN_tnear(ray, args->N, i);
+        float& tfar = RTCRayN_tfar(ray, args->N, i);
+        for (const float t : roots) {
+            if (!(t > tnear && t <= tfar)) continue;
+            if ((s.flags & SurfaceFilter::kNeedsAccept) && !q.filter->accept(*q.ray, sphere_hit(s, t), q.kind)) continue;
+            tfar = t;
+            RTCHitN_u(hit, args->N, i) = 0.f;
+            RTCHitN_v(hit, args->N, i) = 0.f;
+            RTCHitN_Ng_x(hit, args->N, i) = RTCRayN_org_x(ray, args->N, i) + t * RTCRayN_dir_x(ray, args->N, i) - float(s.center.x);
+            RTCHitN_Ng_y(hit, args->N, i) = RTCRayN_org_y(ray, args->N, i) + t * RTCRayN_dir_y(ray, args->N, i) - float(s.center.y);
+            RTCHitN_Ng_z(hit, args->N, i) = RTCRayN_org_z(ray, args->N, i) + t * RTCRayN_dir_z(ray, args->N, i) - float(s.center.z);
+            RTCHitN_primID(hit, args->N, i) = args->primID;
+            RTCHitN_geomID(hit, args->N, i) = args->geomID;
+            RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
+            break;
+        }
+    }
+}
+
+/// Shadow rays: both roots in (tnear, tfar] are crossings (in and out).
+void sphere_occluded_fn(const RTCOccludedFunctionNArguments* args) {
+    const auto& spheres = *static_cast<const SpherePrims<float>*>(args->geometryUserPtr);
+    auto& q = *reinterpret_cast<QueryContext*>(args->context);
+    const SpherePrims<float>::Item& s = spheres.item(args->primID);
+    const bool opaque = !(s.flags & (SurfaceFilter::kNeedsTransmittance | SurfaceFilter::kNeedsAccept));
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        float roots[2];
+        if (!packet_sphere_roots(args->ray, args->N, i, s, roots[0], roots[1])) continue;
+        const float tnear = RTCRayN_tnear(args->ray, args->N, i);
+        float& tfar = RTCRayN_tfar(args->ray, args->N, i);
+        for (uint8_t part = 0; part < 2; ++part) {
+            const float t = roots[part];
+            if (!(t > tnear && t <= tfar)) continue;
+            if (opaque || add_crossing(q, sphere_hit(s, t), part)) {
+                tfar = -kInfinity;  // Embree's mark for an occluded ray
                 break;
             }
         }
-        if (duplicate) {
-            args->valid[i] = 0;
-            continue;
-        }
-        Color tr = q.filter->transmittance(*q.ray, h);
-        if (q.seen_count < kMaxSeen) q.seen[q.seen_count++] = {h.geom, h.inst, h.t};
-        q.transmittance *= tr;
-        if (is_black(q.transmittance)) {
-            q.transmittance = Color(0.f);
-            continue;  // keep the hit: the ray is blocked, traversal stops
-        }
-        args->valid[i] = 0;
     }
 }
 
@@ -202,6 +288,21 @@ public:
             rtcAttachGeometryByID(m_top, g, unsigned(i));
             rtcReleaseGeometry(g);
         }
+        // The spheres: one user geometry with its own callbacks, geometry ID after the instances.
+        m_spheres = SpherePrims<float>(scene, filter);
+        if (m_spheres.size() > 0) {
+            m_sphere_geom_id = unsigned(scene.instances.size());
+            RTCGeometry g = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_USER);
+            rtcSetGeometryUserPrimitiveCount(g, m_spheres.size());
+            rtcSetGeometryUserData(g, &m_spheres);
+            rtcSetGeometryBoundsFunction(g, &sphere_bounds_fn, nullptr);
+            rtcSetGeometryIntersectFunction(g, &sphere_intersect_fn);
+            rtcSetGeometryOccludedFunction(g, &sphere_occluded_fn);
+            rtcCommitGeometry(g);
+            rtcAttachGeometryByID(m_top, g, m_sphere_geom_id);
+            rtcReleaseGeometry(g);
+            m_bytes += m_spheres.bytes();
+        }
         rtcCommitScene(m_top);
         throw_pending("building the scene");
         m_build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -229,6 +330,7 @@ public:
         rtcIntersect1(m_top, &q.rtc, &rh);
         Hit h;
         if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return h;
+        if (rh.hit.geomID == m_sphere_geom_id) return sphere_hit(m_spheres.item(rh.hit.primID), rh.ray.tfar);
         h.t = rh.ray.tfar;
         h.u = rh.hit.u;
         h.v = rh.hit.v;
@@ -292,6 +394,8 @@ private:
     RTCScene m_top = nullptr;
     std::vector<RTCScene> m_mesh_scenes;
     std::vector<uint32_t> m_mesh_of_instance;
+    SpherePrims<float> m_spheres;                         ///< user data of the sphere geometry
+    unsigned m_sphere_geom_id = RTC_INVALID_GEOMETRY_ID;  ///< its geometry ID in m_top
     std::mutex m_error_mutex;
     std::string m_error;
     double m_build_seconds = 0.0;

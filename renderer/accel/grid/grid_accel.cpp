@@ -12,14 +12,17 @@ namespace whitted {
 
 namespace {
 
-/// A uniform grid over one mesh: cell c holds m_refs[m_start[c], m_start[c + 1]) (triangle
-/// indices, ascending), cells ordered x fastest.
-class TriangleGrid {
+/// A uniform grid over a primitive set P (one mesh's triangles, or the scene's spheres): cell c
+/// holds m_refs[m_start[c], m_start[c + 1]) (primitive indices, ascending), cells ordered x
+/// fastest. A primitive is entered into the cells its overlap test accepts (for spheres: the
+/// cells the surface passes through).
+template <typename P>
+class PrimGrid {
 public:
-    TriangleGrid(const Mesh& mesh, const GridConfig& config) : m_tris(mesh_triangles<float>(mesh)) {
-        for (const auto& t : m_tris) m_bounds.extend(triangle_bounds(t));
+    PrimGrid(P prims, const GridConfig& config) : m_prims(std::move(prims)) {
+        for (uint32_t i = 0; i < m_prims.size(); ++i) m_bounds.extend(m_prims.bounds(i));
         choose_resolution(config);
-        bin_triangles();
+        bin_prims();
     }
 
     template <class Query>
@@ -58,14 +61,14 @@ public:
             }
         }
 
-        const WatertightRay<float> wr(org, dir);
+        const typename P::RayData pr = P::ray_data(org, dir);
         Mailbox mailbox;
         for (int guard = m_res[0] + m_res[1] + m_res[2] + 3; guard > 0; --guard) {
-            // Test the triangles of this cell not tested before. A hit beyond the cell stays the
+            // Test the primitives of this cell not tested before. A hit beyond the cell stays the
             // pending closest hit (its t is the query's tmax) and is accepted once the walk
             // reaches the cell that contains it.
             const size_t c = (size_t(cell[2]) * size_t(m_res[1]) + size_t(cell[1])) * size_t(m_res[0]) + size_t(cell[0]);
-            if (test_mailboxed_refs(m_refs, m_start[c], m_start[c + 1], m_tris, mailbox, wr, tnear, q)) return true;
+            if (test_mailboxed_refs(m_refs, m_start[c], m_start[c + 1], m_prims, mailbox, pr, tnear, q)) return true;
             // Step to the neighbour across the nearest boundary (Amanatides & Woo 1987).
             const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
             const float cell_exit = next[a];
@@ -79,8 +82,7 @@ public:
 
     Bounds3f bounds() const { return m_bounds; }
     BlasStats stats() const {
-        return {m_start.size() * 4 + m_refs.size() * 4 + m_tris.size() * sizeof(m_tris[0]), m_start.size() - 1,
-                m_refs.size(), 0.0};
+        return {m_start.size() * 4 + m_refs.size() * 4 + m_prims.bytes(), m_start.size() - 1, m_refs.size(), 0.0};
     }
 
 private:
@@ -90,7 +92,7 @@ private:
         // Flat axes get one cell; the volume uses a tiny thickness for them.
         const float thin = std::max(max_ext * 1e-3f, 1e-30f);
         const double volume = double(std::max(ext.x, thin)) * std::max(ext.y, thin) * std::max(ext.z, thin);
-        double k = std::cbrt(double(config.lambda) * double(m_tris.size()) / volume);
+        double k = std::cbrt(double(config.lambda) * double(m_prims.size()) / volume);
         for (;;) {
             size_t cells = 1;
             for (int a = 0; a < 3; ++a) {
@@ -110,10 +112,10 @@ private:
         }
     }
 
-    /// Cells a triangle overlaps (exact overlap test inside its bounding range of cells).
+    /// Cells primitive i overlaps (its overlap test inside its bounding range of cells).
     template <class F>
-    void for_each_cell(const TriangleVerts<float>& tri, F&& f) const {
-        const Bounds3f b = triangle_bounds(tri);
+    void for_each_cell(uint32_t i, F&& f) const {
+        const Bounds3f b = m_prims.bounds(i);
         int c0[3], c1[3];
         for (int a = 0; a < 3; ++a) {
             c0[a] = std::clamp(int((b.lo[a] - m_lo[a]) * m_inv_cell[a]) - 1, 0, m_res[a] - 1);
@@ -124,27 +126,27 @@ private:
                 for (int x = c0[0]; x <= c1[0]; ++x) {
                     const Vec3f lo{m_lo[0] + float(x) * m_cell[0], m_lo[1] + float(y) * m_cell[1], m_lo[2] + float(z) * m_cell[2]};
                     const Vec3f hi = lo + Vec3f(m_cell[0], m_cell[1], m_cell[2]);
-                    if (triangle_overlaps_box(lo, hi, tri.p0, tri.p1, tri.p2))
+                    if (m_prims.overlaps_box(i, lo, hi))
                         f((size_t(z) * size_t(m_res[1]) + size_t(y)) * size_t(m_res[0]) + size_t(x));
                 }
     }
 
-    /// Counting sort of (cell, triangle) pairs: counts in parallel per triangle, then fills in
-    /// triangle order, so each cell lists its triangles ascending whatever the thread count.
-    void bin_triangles() {
+    /// Counting sort of (cell, primitive) pairs: counts in parallel per primitive, then fills in
+    /// primitive order, so each cell lists its primitives ascending whatever the thread count.
+    void bin_prims() {
         const size_t cells = size_t(m_res[0]) * size_t(m_res[1]) * size_t(m_res[2]);
-        const size_t n = m_tris.size();
-        std::vector<uint32_t> per_tri(n + 1, 0);
+        const size_t n = m_prims.size();
+        std::vector<uint32_t> per_prim(n + 1, 0);
         tbb::parallel_for(size_t(0), n, [&](size_t i) {
             uint32_t c = 0;
-            for_each_cell(m_tris[i], [&](size_t) { ++c; });
-            per_tri[i + 1] = c;
+            for_each_cell(uint32_t(i), [&](size_t) { ++c; });
+            per_prim[i + 1] = c;
         });
-        for (size_t i = 0; i < n; ++i) per_tri[i + 1] += per_tri[i];
-        std::vector<uint32_t> pair_cell(per_tri[n]);
+        for (size_t i = 0; i < n; ++i) per_prim[i + 1] += per_prim[i];
+        std::vector<uint32_t> pair_cell(per_prim[n]);
         tbb::parallel_for(size_t(0), n, [&](size_t i) {
-            uint32_t k = per_tri[i];
-            for_each_cell(m_tris[i], [&](size_t c) { pair_cell[k++] = uint32_t(c); });
+            uint32_t k = per_prim[i];
+            for_each_cell(uint32_t(i), [&](size_t c) { pair_cell[k++] = uint32_t(c); });
         });
         m_start.assign(cells + 1, 0);
         for (uint32_t c : pair_cell) ++m_start[c + 1];
@@ -152,10 +154,10 @@ private:
         m_refs.resize(pair_cell.size());
         std::vector<uint32_t> fill(m_start.begin(), m_start.end() - 1);
         for (size_t i = 0; i < n; ++i)
-            for (uint32_t k = per_tri[i]; k < per_tri[i + 1]; ++k) m_refs[fill[pair_cell[k]]++] = uint32_t(i);
+            for (uint32_t k = per_prim[i]; k < per_prim[i + 1]; ++k) m_refs[fill[pair_cell[k]]++] = uint32_t(i);
     }
 
-    std::vector<TriangleVerts<float>> m_tris;
+    P m_prims;
     Bounds3f m_bounds;
     int m_res[3] = {1, 1, 1};
     float m_lo[3] = {}, m_hi[3] = {}, m_cell[3] = {}, m_inv_cell[3] = {};
@@ -166,8 +168,11 @@ private:
 
 std::unique_ptr<Accelerator> create_grid_accelerator(const Scene& scene, const SurfaceFilter& filter,
                                                      const GridConfig& config) {
-    return std::make_unique<TwoLevelAccelerator<float, TriangleGrid>>(
-        "grid", scene, filter, [&](const Mesh& m) { return TriangleGrid(m, config); }, true);
+    using Blas = PrimGrid<TrianglePrims<float>>;
+    using SphereBlas = PrimGrid<SpherePrims<float>>;
+    return std::make_unique<TwoLevelAccelerator<float, Blas, SphereBlas>>(
+        "grid", scene, filter, [&](const Mesh& m) { return Blas(TrianglePrims<float>(m), config); },
+        [&](SpherePrims<float>&& s) { return SphereBlas(std::move(s), config); }, true);
 }
 
 }  // namespace whitted

@@ -1,4 +1,5 @@
-// `grid`: a uniform voxel grid per mesh, traversed by 3D-DDA (Amanatides & Woo 1987).
+// `grid`: a uniform voxel grid per mesh (and one over the scene's spheres), traversed by 3D-DDA
+// (Amanatides & Woo 1987).
 #pragma once
 
 #include <cstddef>
@@ -18,7 +19,8 @@ struct GridConfig {
     size_t max_cells = size_t(1) << 24;  ///< cap on the total cells (16M cells = 64 MB of offsets)
 };
 
-/// Two-level grid: a grid per mesh, a SAH BVH over the instances.
+/// Two-level grid: a grid per mesh, a SAH BVH over the instances, and one world-space grid over
+/// the spheres (a sphere is entered into the cells its surface passes through).
 std::unique_ptr<Accelerator> create_grid_accelerator(const Scene& scene, const SurfaceFilter& filter,
                                                      const GridConfig& config);
 

@@ -27,11 +27,15 @@ inline void child_box(const Vec3f& lo, const Vec3f& hi, int c, Vec3f& clo, Vec3f
     }
 }
 
-class TriangleOctree {
+/// An adaptive octree over a primitive set P (one mesh's triangles, or the scene's spheres); a
+/// primitive goes to every child its overlap test accepts (for spheres: the children the surface
+/// passes through).
+template <typename P>
+class PrimOctree {
 public:
-    TriangleOctree(const Mesh& mesh, const OctreeConfig& config) : m_tris(mesh_triangles<float>(mesh)), m_config(config) {
-        for (const auto& t : m_tris) m_bounds.extend(triangle_bounds(t));
-        // A cube around the mesh, padded so that vertices on its faces are inside.
+    PrimOctree(P prims, const OctreeConfig& config) : m_prims(std::move(prims)), m_config(config) {
+        for (uint32_t i = 0; i < m_prims.size(); ++i) m_bounds.extend(m_prims.bounds(i));
+        // A cube around the primitives, padded so that vertices on its faces are inside.
         const Vec3f c = m_bounds.center();
         const float half = max_component(m_bounds.diagonal()) * 0.5f * (1.f + 1e-5f) + 1e-30f;
         m_root_lo = c - Vec3f(half);
@@ -39,7 +43,7 @@ public:
         m_min_extent = 2.f * half * config.min_extent;
         m_max_depth = std::clamp(config.max_depth, 0, kOctreeHardMaxDepth);
 
-        std::vector<uint32_t> all(m_tris.size());
+        std::vector<uint32_t> all(m_prims.size());
         for (size_t i = 0; i < all.size(); ++i) all[i] = uint32_t(i);
         std::unique_ptr<TempNode> root = build(std::move(all), m_root_lo, m_root_hi, 0, 0);
         flatten(*root);
@@ -48,7 +52,7 @@ public:
     template <class Query>
     bool traverse(const Vec3f& org, const Vec3f& dir, float tnear, Query& q) const {
         const SlabRay<float> slab(org, dir);
-        const WatertightRay<float> wr(org, dir);
+        const typename P::RayData pr = P::ray_data(org, dir);
         // Children are visited in the order i ^ mask, i = 0..7: a ray crosses each midplane at
         // most once, in the direction of its sign, so this is front to back for any ray.
         const int mask = (std::signbit(dir.x) ? 1 : 0) | (std::signbit(dir.y) ? 2 : 0) | (std::signbit(dir.z) ? 4 : 0);
@@ -66,7 +70,7 @@ public:
             if (slab_entry(slab, e.lo, e.hi, tnear, q.tmax) == kInfinity) continue;
             const Node& n = m_nodes[e.node];
             if (n.count != kInner) {
-                if (test_mailboxed_refs(m_refs, n.index, n.index + n.count, m_tris, mailbox, wr, tnear, q)) return true;
+                if (test_mailboxed_refs(m_refs, n.index, n.index + n.count, m_prims, mailbox, pr, tnear, q)) return true;
                 continue;
             }
             for (int i = 7; i >= 0; --i) {
@@ -81,8 +85,7 @@ public:
 
     Bounds3f bounds() const { return m_bounds; }
     BlasStats stats() const {
-        return {m_nodes.size() * sizeof(Node) + m_refs.size() * 4 + m_tris.size() * sizeof(m_tris[0]), m_nodes.size(),
-                m_refs.size(), 0.0};
+        return {m_nodes.size() * sizeof(Node) + m_refs.size() * 4 + m_prims.bytes(), m_nodes.size(), m_refs.size(), 0.0};
     }
 
 private:
@@ -103,15 +106,13 @@ private:
             node->prims = std::move(prims);
             return node;
         }
-        // Distribute the triangles over the 8 children (a triangle may go to several).
+        // Distribute the primitives over the 8 children (a primitive may go to several).
         std::array<std::vector<uint32_t>, 8> sub;
         std::array<Vec3f, 8> clo, chi;
         for (int c = 0; c < 8; ++c) child_box(lo, hi, c, clo[size_t(c)], chi[size_t(c)]);
-        for (uint32_t p : prims) {
-            const TriangleVerts<float>& t = m_tris[p];
+        for (uint32_t p : prims)
             for (int c = 0; c < 8; ++c)
-                if (triangle_overlaps_box(clo[size_t(c)], chi[size_t(c)], t.p0, t.p1, t.p2)) sub[size_t(c)].push_back(p);
-        }
+                if (m_prims.overlaps_box(p, clo[size_t(c)], chi[size_t(c)])) sub[size_t(c)].push_back(p);
         bool stalls = false;
         for (const auto& s : sub) stalls |= s.size() == prims.size();
         const int next_stalled = stalls ? stalled + 1 : 0;
@@ -147,7 +148,7 @@ private:
         }
     }
 
-    std::vector<TriangleVerts<float>> m_tris;
+    P m_prims;
     OctreeConfig m_config;
     Bounds3f m_bounds;
     Vec3f m_root_lo, m_root_hi;
@@ -161,8 +162,11 @@ private:
 
 std::unique_ptr<Accelerator> create_octree_accelerator(const Scene& scene, const SurfaceFilter& filter,
                                                        const OctreeConfig& config) {
-    return std::make_unique<TwoLevelAccelerator<float, TriangleOctree>>(
-        "octree", scene, filter, [&](const Mesh& m) { return TriangleOctree(m, config); }, true);
+    using Blas = PrimOctree<TrianglePrims<float>>;
+    using SphereBlas = PrimOctree<SpherePrims<float>>;
+    return std::make_unique<TwoLevelAccelerator<float, Blas, SphereBlas>>(
+        "octree", scene, filter, [&](const Mesh& m) { return Blas(TrianglePrims<float>(m), config); },
+        [&](SpherePrims<float>&& s) { return SphereBlas(std::move(s), config); }, true);
 }
 
 }  // namespace whitted

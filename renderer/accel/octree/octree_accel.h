@@ -1,4 +1,5 @@
-// `octree`: an adaptive octree per mesh (Glassner 1984), traversed front to back.
+// `octree`: an adaptive octree per mesh (and one over the scene's spheres; Glassner 1984),
+// traversed front to back.
 #pragma once
 
 #include <cstdint>
@@ -20,7 +21,8 @@ struct OctreeConfig {
                                      ///< max_depth costs millions of nodes (0 = make it a leaf)
 };
 
-/// Two-level octree: an octree per mesh, a SAH BVH over the instances.
+/// Two-level octree: an octree per mesh, a SAH BVH over the instances, and one world-space octree
+/// over the spheres.
 std::unique_ptr<Accelerator> create_octree_accelerator(const Scene& scene, const SurfaceFilter& filter,
                                                        const OctreeConfig& config);
 

@@ -1,0 +1,349 @@
+// JSON parsing with locations for the scene file (docs/scene-format.md "Errors").
+
+#include "importers/scene_file_json.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <unordered_set>
+
+#include <fmt/format.h>
+
+namespace whitted::scene_file {
+
+namespace {
+
+/// Thrown from the parser callback (duplicate key, nesting): carries the message and pointer.
+struct CallbackError {
+    std::string message;
+    std::string pointer;
+};
+
+/// The parser callback's view of where it is: one frame per open object/array.
+struct Frame {
+    bool is_object = false;
+    std::string key;                        ///< object: the current member
+    long index = -1;                        ///< array: the current element
+    std::unordered_set<std::string> keys;   ///< object: members seen so far
+};
+
+std::string frames_pointer(const std::vector<Frame>& frames) {
+    std::string p;
+    for (const Frame& f : frames) p += "/" + (f.is_object ? pointer_token(f.key) : std::to_string(std::max(0L, f.index)));
+    return p;
+}
+
+bool is_ws(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
+
+size_t skip_ws(std::string_view t, size_t i) {
+    while (i < t.size() && is_ws(t[i])) ++i;
+    return i;
+}
+
+/// `i` at an opening quote: the index after the closing one.
+size_t skip_string(std::string_view t, size_t i) {
+    for (++i; i < t.size(); ++i) {
+        if (t[i] == '\\') ++i;
+        else if (t[i] == '"') return i + 1;
+    }
+    return t.size();
+}
+
+/// `i` at the first character of a value: the index after it.
+size_t skip_value(std::string_view t, size_t i) {
+    if (i >= t.size()) return i;
+    if (t[i] == '"') return skip_string(t, i);
+    if (t[i] == '{' || t[i] == '[') {
+        size_t depth = 0;
+        while (i < t.size()) {
+            const char c = t[i];
+            if (c == '"') {
+                i = skip_string(t, i);
+                continue;
+            }
+            if (c == '{' || c == '[') ++depth;
+            if (c == '}' || c == ']') {
+                if (--depth == 0) return i + 1;
+            }
+            ++i;
+        }
+        return i;
+    }
+    while (i < t.size() && !is_ws(t[i]) && t[i] != ',' && t[i] != ']' && t[i] != '}') ++i;
+    return i;
+}
+
+/// The decoded text of the JSON string starting at `i` (a quote).
+std::string string_at(std::string_view t, size_t i) {
+    const size_t end = skip_string(t, i);
+    const std::string_view raw = t.substr(i, end - i);
+    if (raw.find('\\') == std::string_view::npos) return std::string(raw.substr(1, raw.size() >= 2 ? raw.size() - 2 : 0));
+    try {
+        return Json::parse(raw).get<std::string>();
+    } catch (const std::exception&) {
+        return std::string(raw);
+    }
+}
+
+std::vector<std::string> pointer_tokens(std::string_view pointer) {
+    std::vector<std::string> tokens;
+    size_t i = 0;
+    while (i < pointer.size() && pointer[i] == '/') {
+        size_t j = pointer.find('/', i + 1);
+        if (j == std::string_view::npos) j = pointer.size();
+        std::string tok;
+        for (size_t k = i + 1; k < j; ++k) {
+            if (pointer[k] == '~' && k + 1 < j) {
+                tok += pointer[k + 1] == '1' ? '/' : '~';
+                ++k;
+            } else {
+                tok += pointer[k];
+            }
+        }
+        tokens.push_back(std::move(tok));
+        i = j;
+    }
+    return tokens;
+}
+
+/// Offset of the first number token whose value is outside the double range, or npos.
+size_t find_overflowing_number(std::string_view t) {
+    for (size_t i = 0; i < t.size();) {
+        const char c = t[i];
+        if (c == '"') {
+            i = skip_string(t, i);
+        } else if (c == '-' || (c >= '0' && c <= '9')) {
+            size_t j = i;
+            while (j < t.size() && (std::isdigit((unsigned char)t[j]) || t[j] == '-' || t[j] == '+' || t[j] == '.' ||
+                                    t[j] == 'e' || t[j] == 'E'))
+                ++j;
+            const std::string token(t.substr(i, j - i));
+            if (!std::isfinite(std::strtod(token.c_str(), nullptr))) return i;
+            i = j;
+        } else {
+            ++i;
+        }
+    }
+    return std::string::npos;
+}
+
+/// nlohmann's parse_error text without its "[json.exception...] parse error at line L, column C: "
+/// prefix (the location is reported in whitted's own format).
+std::string strip_nlohmann_prefix(const std::string& what) {
+    std::string s = what;
+    if (const size_t p = s.find("] "); p != std::string::npos && s.rfind("[json.exception", 0) == 0) s = s.substr(p + 2);
+    if (s.rfind("parse error", 0) == 0) {
+        if (const size_t p = s.find(": "); p != std::string::npos) s = s.substr(p + 2);
+    }
+    // Control characters (a raw byte quoted from the file) must not reach the terminal.
+    for (char& c : s)
+        if ((unsigned char)c < 0x20 || c == 0x7f) c = '?';
+    return s;
+}
+
+[[noreturn]] void fail_at(const std::string& path, std::string_view text, size_t offset, const std::string& pointer,
+                          const std::string& message) {
+    FileLoc loc;
+    loc.file = path;
+    loc.pointer = pointer;
+    std::tie(loc.line, loc.column) = line_column(text, std::min(offset, text.size()));
+    throw Error(loc, message);
+}
+
+}  // namespace
+
+std::string pointer_token(std::string_view key) {
+    std::string s;
+    for (char c : key) {
+        if (c == '~') s += "~0";
+        else if (c == '/') s += "~1";
+        else s += c;
+    }
+    return s;
+}
+
+std::pair<int, int> line_column(std::string_view text, size_t offset) {
+    offset = std::min(offset, text.size());
+    int line = 1;
+    size_t line_start = 0;
+    for (size_t i = 0; i < offset; ++i)
+        if (text[i] == '\n') ++line, line_start = i + 1;
+    int column = 1;
+    for (size_t i = line_start; i < offset; ++i)
+        if ((static_cast<unsigned char>(text[i]) & 0xC0) != 0x80) ++column;  // UTF-8 continuation bytes
+    return {line, column};
+}
+
+TextPosition find_pointer(std::string_view t, std::string_view pointer) {
+    TextPosition pos;
+    pos.value = skip_ws(t, 0);
+    pos.exact = true;
+    for (const std::string& token : pointer_tokens(pointer)) {
+        const size_t at = pos.value;
+        if (at >= t.size() || (t[at] != '{' && t[at] != '[')) return {pos.value, pos.key, false};
+        size_t i = skip_ws(t, at + 1);
+        size_t found = std::string::npos, found_key = std::string::npos;
+        if (t[at] == '{') {
+            // Members: the last one named `token` (nlohmann keeps the last of duplicates).
+            while (i < t.size() && t[i] == '"') {
+                const size_t key = i;
+                const std::string name = string_at(t, i);
+                i = skip_ws(t, skip_string(t, i));
+                if (i < t.size() && t[i] == ':') i = skip_ws(t, i + 1);
+                if (name == token) found = i, found_key = key;
+                i = skip_ws(t, skip_value(t, i));
+                if (i < t.size() && t[i] == ',') i = skip_ws(t, i + 1);
+            }
+        } else {
+            char* end = nullptr;
+            const unsigned long want = std::strtoul(token.c_str(), &end, 10);
+            if (token.empty() || *end != '\0') return {pos.value, pos.key, false};
+            for (unsigned long k = 0; i < t.size() && t[i] != ']'; ++k) {
+                if (k == want) {
+                    found = i;
+                    break;
+                }
+                i = skip_ws(t, skip_value(t, i));
+                if (i < t.size() && t[i] == ',') i = skip_ws(t, i + 1);
+            }
+        }
+        if (found == std::string::npos) return {pos.value, pos.key, false};
+        pos.value = found;
+        pos.key = found_key;
+    }
+    return pos;
+}
+
+FileLoc locate(const JsonDocument& doc, const std::string& pointer, bool at_key) {
+    FileLoc loc;
+    loc.file = doc.path;
+    loc.pointer = pointer;
+    const TextPosition p = find_pointer(doc.text, pointer);
+    const size_t offset = at_key && p.exact && p.key != std::string::npos ? p.key : p.value;
+    std::tie(loc.line, loc.column) = line_column(doc.text, offset);
+    return loc;
+}
+
+JsonDocument parse_json_document(std::string text, const std::string& path) {
+    JsonDocument doc;
+    doc.path = path;
+    doc.text = std::move(text);
+    const std::string_view t = doc.text;
+    if (t.size() >= 3 && (unsigned char)t[0] == 0xEF && (unsigned char)t[1] == 0xBB && (unsigned char)t[2] == 0xBF)
+        fail_at(path, t, 0, "", "invalid JSON: the file starts with a UTF-8 byte order mark (save it without one)");
+
+    // The callback tracks the pointer of what is being parsed, refuses duplicate keys and deep
+    // nesting, and records the order of /materials and /textures (nlohmann::json sorts keys).
+    std::vector<Frame> frames;
+    auto callback = [&](int, Json::parse_event_t event, Json& parsed) -> bool {
+        switch (event) {
+            case Json::parse_event_t::object_start:
+            case Json::parse_event_t::array_start: {
+                if (!frames.empty() && !frames.back().is_object) ++frames.back().index;
+                if (frames.size() >= size_t(kMaxJsonDepth))
+                    throw CallbackError{fmt::format("invalid JSON: arrays/objects nested deeper than {} levels",
+                                                    kMaxJsonDepth),
+                                        frames_pointer(frames)};
+                Frame f;
+                f.is_object = event == Json::parse_event_t::object_start;
+                frames.push_back(std::move(f));
+                break;
+            }
+            case Json::parse_event_t::object_end:
+            case Json::parse_event_t::array_end:
+                if (!frames.empty()) frames.pop_back();
+                break;
+            case Json::parse_event_t::key: {
+                Frame& f = frames.back();
+                f.key = parsed.get<std::string>();
+                if (!f.keys.insert(f.key).second)
+                    throw CallbackError{fmt::format("duplicate key '{}' (each key may appear once per object)", f.key),
+                                        frames_pointer(frames)};
+                if (frames.size() == 2 && frames[1].is_object && frames[0].is_object) {
+                    if (frames[0].key == "materials") doc.material_order.push_back(f.key);
+                    if (frames[0].key == "textures") doc.texture_order.push_back(f.key);
+                }
+                break;
+            }
+            case Json::parse_event_t::value:
+                if (!frames.empty() && !frames.back().is_object) ++frames.back().index;
+                break;
+        }
+        return true;
+    };
+
+    try {
+        doc.root = Json::parse(doc.text, callback);
+    } catch (const CallbackError& e) {
+        // The pointer is known; the offset of a duplicate key is the last member of that name.
+        const TextPosition p = find_pointer(t, e.pointer);
+        fail_at(path, t, p.key != std::string::npos ? p.key : p.value, e.pointer, e.message);
+    } catch (const Json::parse_error& e) {
+        // e.byte: 1-based index of the last character read.
+        fail_at(path, t, e.byte > 0 ? size_t(e.byte - 1) : 0, "", "invalid JSON: " + strip_nlohmann_prefix(e.what()));
+    } catch (const Json::out_of_range& e) {
+        const size_t at = find_overflowing_number(t);
+        fail_at(path, t, at == std::string::npos ? 0 : at, "",
+                "invalid number: " + strip_nlohmann_prefix(e.what()) + " (outside the range of a double)");
+    } catch (const std::bad_alloc&) {
+        throw Error(FileLoc{path, "", 0, 0}, "out of memory while parsing the JSON");
+    }
+    return doc;
+}
+
+std::string closest_match(std::string_view name, const std::vector<std::string>& candidates) {
+    auto lower = [](std::string_view s) {
+        std::string r(s);
+        for (char& c : r) c = char(std::tolower((unsigned char)c));
+        return r;
+    };
+    const std::string a = lower(name);
+    if (a.size() > 64) return "";
+    std::string best;
+    size_t best_d = SIZE_MAX;
+    for (const std::string& cand : candidates) {
+        const std::string b = lower(cand);
+        if (b.size() > 64) continue;
+        // Optimal string alignment distance (Levenshtein plus adjacent transpositions).
+        std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
+        for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+        for (size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+        for (size_t i = 1; i <= a.size(); ++i)
+            for (size_t j = 1; j <= b.size(); ++j) {
+                const size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+                d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+                if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+                    d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+            }
+        const size_t dist = d[a.size()][b.size()];
+        // Close enough to be a typo: about one edit per three characters, at least one; or another
+        // form of the same word (a common stem of 4+ characters: "rotation" for "rotate").
+        const size_t limit = std::max<size_t>(1, std::min(a.size(), b.size()) / 3);
+        size_t stem = 0;
+        while (stem < a.size() && stem < b.size() && a[stem] == b[stem]) ++stem;
+        const bool same_word = stem >= 4 && 2 * stem >= std::max(a.size(), b.size());
+        if ((dist <= limit || same_word) && dist < best_d) best = cand, best_d = dist;
+    }
+    return best;
+}
+
+std::string describe(const Json& v) {
+    switch (v.type()) {
+        case Json::value_t::null: return "null";
+        case Json::value_t::boolean: return v.get<bool>() ? "true" : "false";
+        case Json::value_t::string: {
+            std::string s = v.get<std::string>();
+            if (s.size() > 40) s = s.substr(0, 37) + "...";
+            return Json(s).dump(-1, ' ', false, Json::error_handler_t::replace);
+        }
+        case Json::value_t::array: {
+            const size_t n = v.size();
+            return n == 0 ? "an empty array" : fmt::format("an array of {} element{}", n, n == 1 ? "" : "s");
+        }
+        case Json::value_t::object: return v.empty() ? "an empty object" : "an object";
+        default: return v.dump();
+    }
+}
+
+}  // namespace whitted::scene_file
