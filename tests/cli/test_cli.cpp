@@ -134,4 +134,73 @@ TEST(Cli, InfoPrintsCounts) {
     EXPECT_NE(r.out.find("12"), std::string::npos) << r.out;  // 12 triangles
 }
 
+// ---- scene files (docs/scene-format.md) ----
+
+/// Writes a small scene file into a fresh folder and returns its path.
+fs::path write_scene_file(const std::string& name, const std::string& text) {
+    const fs::path dir = fs::temp_directory_path() / ("whitted_cli_scene_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path p = dir / name;
+    std::ofstream(p) << text;
+    return p;
+}
+
+const char* kSmallScene = R"({
+  "version": 1,
+  "render": {"width": 24, "height": 16, "aa": "center", "max_depth": 2, "output": "from_file.png"},
+  "camera": {"position": [0, 1, 4], "look_at": [0, 0.5, 0], "fov": 40},
+  "materials": {"red": {"kd": [0.8, 0.1, 0.1]}, "glass": {"kt": 0.9, "ks": 0.05, "ior": 1.5}},
+  "objects": [
+    {"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "material": "red"},
+    {"type": "sphere", "center": [0, 0.6, 0], "radius": 0.5, "material": "glass"}
+  ],
+  "lights": [{"type": "point", "position": [2, 4, 3], "intensity": 20}]
+})";
+
+TEST(Cli, SceneFileSettingsApplyAndFlagsOverrideThem) {
+    const fs::path scene = write_scene_file("small.json", kSmallScene);
+    const fs::path from_file = scene.parent_path() / "from_file.png";
+    fs::remove(from_file);
+    // No flags: size and output come from the file; the output is relative to the scene file.
+    Result r = run("render '" + scene.string() + "' --no-progress");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(from_file));
+    EXPECT_NE(r.err.find("(24x16)"), std::string::npos) << r.err;
+    // Flags win over the file, each on its own: width from the flag, height still from the file.
+    const fs::path out = fs::temp_directory_path() / "whitted_cli_override.png";
+    fs::remove(out);
+    r = run("render '" + scene.string() + "' --no-progress --width 30 -o '" + out.string() + "'");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(out));
+    EXPECT_NE(r.err.find("(30x16)"), std::string::npos) << r.err;
+}
+
+TEST(Cli, BadSceneFileIsOneLineWithLineAndColumn) {
+    std::string text = kSmallScene;
+    text.replace(text.find("\"radius\""), 8, "\"radios\"");  // line 8 of the file
+    const fs::path scene = write_scene_file("typo.json", text);
+    Result r = run("render '" + scene.string() + "' --no-progress");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("typo.json:8:"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("radius"), std::string::npos) << r.err;  // the did-you-mean suggestion
+    // Broken JSON: the line and column of the syntax error.
+    const fs::path broken = write_scene_file("broken.json", "{\n  \"version\": 1,\n  \"objects\": [\n}\n");
+    r = run("info '" + broken.string() + "'");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("broken.json:4:"), std::string::npos) << r.err;
+}
+
+TEST(Cli, BundledSceneFilesRender) {
+    for (const char* name : {"whitted1980.json", "transparent_shadows.json", "glass_mirror_room.json"}) {
+        const fs::path out = fs::temp_directory_path() / (std::string("whitted_cli_") + name + ".png");
+        fs::remove(out);
+        Result r = run("render '" + std::string(WHITTED_ASSETS_DIR) + "/scenes/" + name +
+                       "' --width 40 --height 30 --aa center --no-progress -o '" + out.string() + "'");
+        EXPECT_EQ(r.code, 0) << name << ": " << r.err;
+        EXPECT_TRUE(fs::exists(out)) << name;
+    }
+}
+
 }  // namespace
