@@ -6,7 +6,8 @@
 writes OUT_DIR/gltf (JSON glTF with every external buffer and image inlined as a data: URI, so a
 harness that never reads the file system still sees the whole file), OUT_DIR/glb (the repo's
 small .glb files, plus a GLB made from each inlined glTF with buffer 0 as the BIN chunk) and
-OUT_DIR/image (PNG and JPEG files, and the images embedded in .glb files). Sources: assets/ and
+OUT_DIR/image (PNG and JPEG files, and the images embedded in .glb files) and OUT_DIR/scene
+(the JSON scene files: assets/scenes/*.json and the fixtures of tests/data/scene-files). Sources: assets/ and
 tests/data/ (the broken files of tests/data/gltf-invalid and tests/data/fuzz-regressions).
 Deterministic: the same tree gives the same corpus; files above --max-size are left out.
 """
@@ -116,13 +117,18 @@ def main():
             write(out / "image", img, cap)
     for p in files({".png", ".jpg", ".jpeg"}):
         write(out / "image", p.read_bytes(), cap)
+    # Scene files: the bundled scenes and the test fixtures (JSON, read as they are).
+    for p in files({".json"}):
+        if p.name.endswith(".schema.json"):
+            continue
+        write(out / "scene", p.read_bytes(), cap)
     # tests/data/fuzz-regressions/<harness>/... go to that harness's corpus as they are.
     reg = ROOT / "tests" / "data" / "fuzz-regressions"
-    for harness in ("gltf", "glb", "image"):
+    for harness in ("gltf", "glb", "image", "scene"):
         for p in sorted((reg / harness).glob("*")) if (reg / harness).is_dir() else []:
             if p.is_file() and p.suffix != ".md":
                 write(out / harness, p.read_bytes(), 1 << 30)
-    for harness in ("gltf", "glb", "image"):
+    for harness in ("gltf", "glb", "image", "scene"):
         n = len(list((out / harness).glob("*"))) if (out / harness).is_dir() else 0
         print(f"make_corpus: {harness}: {n} seeds")
 
