@@ -35,13 +35,14 @@ public:
         // Primitives in leaf order: a leaf reads a contiguous run.
         m_prims.reorder(m_ids);
         if (!built.empty()) m_bounds = built[0].box;
+        m_extent = abs_extent(m_bounds.lo, m_bounds.hi);
         fit(built);
     }
 
     template <class Query>
     bool traverse(const Vec3<T>& org, const Vec3<T>& dir, T tnear, Query& q) const {
         const typename P::RayData pr = P::ray_data(org, dir);
-        const auto vray = VolumeRay<T, V>::make(SlabRay<T>(org, dir));
+        const auto vray = VolumeRay<T, V>::make(SlabRay<T>(org, dir, m_extent));
         bool stop = false;
         traverse_bvh(m_nodes, vray, tnear, q.tmax, [&](uint32_t first, uint32_t count) {
             for (uint32_t i = first; i < first + count; ++i)
@@ -104,6 +105,7 @@ private:
     P m_prims;
     std::vector<uint32_t> m_ids;   ///< slot -> original primitive index
     Bounds3<T> m_bounds;
+    T m_extent = 0;                ///< largest absolute coordinate (SlabRay culling slack)
     double m_sah = 0.0;
 };
 

@@ -100,7 +100,7 @@ inline void traverse_bvh(const std::vector<BvhNode<V>>& nodes, const RayData& ra
         for (;;) {
             if (sp == 0) return;
             const Entry e = stack[--sp];
-            if (e.dist <= tmax * kRayTmaxScale<T>) {
+            if (e.dist <= tmax * kRayTmaxScale<T> + ray.t_slack) {
                 current = e.node;
                 break;
             }

@@ -113,11 +113,35 @@ template <typename T>
 struct SlabRay {
     Vec3<T> org, dir, inv_dir;
     bool neg[3] = {false, false, false};
+    T t_slack = 0;  ///< absolute enlargement of tmax in culling tests (see cull_slack)
     SlabRay() = default;
-    SlabRay(const Vec3<T>& o, const Vec3<T>& d) : org(o), dir(d), inv_dir(T(1) / d.x, T(1) / d.y, T(1) / d.z) {
+    /// `extent` bounds the absolute coordinates of everything the structure holds (0 = no slack).
+    SlabRay(const Vec3<T>& o, const Vec3<T>& d, T extent = 0)
+        : org(o), dir(d), inv_dir(T(1) / d.x, T(1) / d.y, T(1) / d.z) {
         for (int k = 0; k < 3; ++k) neg[k] = std::signbit(d[k]);
+        if (extent > 0) t_slack = cull_slack(o, d, extent);
+    }
+    /// Absolute error bound of a primitive test's t along this ray: the watertight triangle test
+    /// (and the sphere quadratic) compute t from vertex - origin differences, so its error scales
+    /// with max|p - o| / max|d_k| (the shear's dominant axis), not with t itself. A hit at a small
+    /// t far from the origin can therefore come out below the entry distance of a box it lies on
+    /// (a flat floor's box, a ray with tfar exactly at its hit): culling tests compare against
+    /// tmax * kRayTmaxScale + t_slack so rounding never culls a box holding an accepted hit.
+    static T cull_slack(const Vec3<T>& o, const Vec3<T>& d, T extent) {
+        const T o_max = std::max(std::fabs(o.x), std::max(std::fabs(o.y), std::fabs(o.z)));
+        const T d_max = std::max(std::fabs(d.x), std::max(std::fabs(d.y), std::fabs(d.z)));
+        const T s = T(32) * std::numeric_limits<T>::epsilon() * (o_max + extent) / d_max;
+        return std::isfinite(s) ? s : T(0);
     }
 };
+
+/// Largest absolute coordinate of a box (the `extent` of SlabRay).
+template <typename T>
+inline T abs_extent(const Vec3<T>& lo, const Vec3<T>& hi) {
+    T e = 0;
+    for (int k = 0; k < 3; ++k) e = std::max(e, std::max(std::fabs(lo[k]), std::fabs(hi[k])));
+    return std::isfinite(e) ? e : T(0);
+}
 
 /// Enlargement of a slab exit distance that absorbs the rounding of (p - o) * inv_d (Ize 2013).
 template <typename T>
@@ -137,7 +161,7 @@ constexpr T kRayTmaxScale = T(1) + T(4) * rounding_gamma<T>(8);
 /// never cull a box the ray touches.
 template <typename T>
 inline T slab_entry(const SlabRay<T>& r, const Vec3<T>& lo, const Vec3<T>& hi, T tmin, T tmax) {
-    tmax *= kRayTmaxScale<T>;
+    tmax = tmax * kRayTmaxScale<T> + r.t_slack;
     for (int k = 0; k < 3; ++k) {
         const T t_near = ((r.neg[k] ? hi[k] : lo[k]) - r.org[k]) * r.inv_dir[k];
         const T t_far = ((r.neg[k] ? lo[k] : hi[k]) - r.org[k]) * r.inv_dir[k] * kSlabExitScale<T>;
@@ -181,7 +205,7 @@ inline T volume_entry(const SlabRay<T>& r, const SphereVolume<T>& s, T tmin, T t
     const T half = std::sqrt((r2 - p2) / dd) * (T(1) + T(8) * rounding_gamma<T>(1));
     const T slack = T(8) * rounding_gamma<T>(1) * std::fabs(tc);
     const T t0 = std::max(tmin, tc - half - slack);
-    const T t1 = std::min(tmax * kRayTmaxScale<T>, tc + half + slack);
+    const T t1 = std::min(tmax * kRayTmaxScale<T> + r.t_slack, tc + half + slack);
     return t0 <= t1 ? t0 : std::numeric_limits<T>::infinity();
 }
 
@@ -208,8 +232,9 @@ template <typename T>
 struct KdopRay {
     T org[kKdopSlabs], inv_dir[kKdopSlabs], org_err[kKdopSlabs];
     bool neg[kKdopSlabs];
+    T t_slack = 0;  ///< as SlabRay::t_slack
     KdopRay() = default;
-    explicit KdopRay(const SlabRay<T>& r) {
+    explicit KdopRay(const SlabRay<T>& r) : t_slack(r.t_slack) {
         const T abs_sum = std::fabs(r.org.x) + std::fabs(r.org.y) + std::fabs(r.org.z);
         for (int k = 0; k < kKdopSlabs; ++k) {
             const T d = kdop_project(k, r.dir);
@@ -224,7 +249,7 @@ struct KdopRay {
 template <typename T>
 inline T volume_entry(const KdopRay<T>& r, const KdopVolume<T>& v, T tmin, T tmax) {
     constexpr T grow = T(1) + T(4) * rounding_gamma<T>(5);
-    tmax *= kRayTmaxScale<T>;
+    tmax = tmax * kRayTmaxScale<T> + r.t_slack;
     for (int k = 0; k < kKdopSlabs; ++k) {
         // Same plane selection and NaN rule as slab_entry, slabs widened by the projection error.
         const T lo = v.lo[k] - r.org_err[k], hi = v.hi[k] + r.org_err[k];

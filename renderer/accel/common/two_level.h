@@ -185,7 +185,7 @@ private:
                 if (visit(d)) return;
             return;
         }
-        const SlabRay<T> slab(org, dir);
+        const SlabRay<T> slab(org, dir, m_top.empty() ? T(0) : abs_extent(m_top[0].volume.lo, m_top[0].volume.hi));
         traverse_bvh(m_top, slab, tnear, q.tmax, [&](uint32_t first, uint32_t count) {
             for (uint32_t k = 0; k < count; ++k)
                 if (visit(m_instances[m_top_ids[first + k]])) return true;

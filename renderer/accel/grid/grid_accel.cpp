@@ -28,10 +28,11 @@ public:
     template <class Query>
     bool traverse(const Vec3f& org, const Vec3f& dir, float tnear, Query& q) const {
         // Clip the ray to the grid box.
-        const SlabRay<float> slab(org, dir);
-        const float t_enter = slab_entry(slab, Vec3f(m_lo[0], m_lo[1], m_lo[2]), Vec3f(m_hi[0], m_hi[1], m_hi[2]), tnear, q.tmax);
+        const Vec3f lo(m_lo[0], m_lo[1], m_lo[2]), hi(m_hi[0], m_hi[1], m_hi[2]);
+        const SlabRay<float> slab(org, dir, abs_extent(lo, hi));
+        const float t_enter = slab_entry(slab, lo, hi, tnear, q.tmax);
         if (t_enter == kInfinity) return false;
-        float t_exit = q.tmax * kRayTmaxScale<float>;
+        float t_exit = q.tmax * kRayTmaxScale<float> + slab.t_slack;
         for (int a = 0; a < 3; ++a) {
             const float t_far = ((slab.neg[a] ? m_lo[a] : m_hi[a]) - org[a]) * slab.inv_dir[a] * kSlabExitScale<float>;
             t_exit = t_far < t_exit ? t_far : t_exit;
@@ -102,9 +103,12 @@ private:
             if (cells <= config.max_cells) break;
             k *= 0.9;
         }
-        // Pad the box slightly so that vertices on its faces land inside a cell.
+        // Pad the box slightly so that vertices on its faces land inside a cell. The pad also scales
+        // with the coordinates' magnitude: a flat or point-sized box far from the origin must still
+        // get cells of non-zero float size (1e-30 alone vanishes next to a coordinate of 1).
         for (int a = 0; a < 3; ++a) {
-            const float pad = std::max(ext[a], max_ext) * 1e-5f + 1e-30f;
+            const float mag = std::max(std::fabs(m_bounds.lo[a]), std::fabs(m_bounds.hi[a]));
+            const float pad = std::max(ext[a], max_ext) * 1e-5f + mag * 1e-6f + 1e-30f;
             m_lo[a] = m_bounds.lo[a] - pad;
             m_hi[a] = m_bounds.hi[a] + pad;
             m_cell[a] = (m_hi[a] - m_lo[a]) / float(m_res[a]);

@@ -37,7 +37,9 @@ public:
         for (uint32_t i = 0; i < m_prims.size(); ++i) m_bounds.extend(m_prims.bounds(i));
         // A cube around the primitives, padded so that vertices on its faces are inside.
         const Vec3f c = m_bounds.center();
-        const float half = max_component(m_bounds.diagonal()) * 0.5f * (1.f + 1e-5f) + 1e-30f;
+        // Half size of the root cube, padded relative to the coordinates too (see the grid).
+        const float mag = abs_extent(m_bounds.lo, m_bounds.hi);
+        const float half = max_component(m_bounds.diagonal()) * 0.5f * (1.f + 1e-5f) + mag * 1e-6f + 1e-30f;
         m_root_lo = c - Vec3f(half);
         m_root_hi = c + Vec3f(half);
         m_min_extent = 2.f * half * config.min_extent;
@@ -51,7 +53,7 @@ public:
 
     template <class Query>
     bool traverse(const Vec3f& org, const Vec3f& dir, float tnear, Query& q) const {
-        const SlabRay<float> slab(org, dir);
+        const SlabRay<float> slab(org, dir, abs_extent(m_root_lo, m_root_hi));
         const typename P::RayData pr = P::ray_data(org, dir);
         // Children are visited in the order i ^ mask, i = 0..7: a ray crosses each midplane at
         // most once, in the direction of its sign, so this is front to back for any ray.
