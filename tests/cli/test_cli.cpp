@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
+#include <csignal>
 
 #include <cstdio>
 #include <filesystem>
@@ -201,6 +203,48 @@ TEST(Cli, BundledSceneFilesRender) {
         EXPECT_EQ(r.code, 0) << name << ": " << r.err;
         EXPECT_TRUE(fs::exists(out)) << name;
     }
+}
+
+// ---- interruption ----
+
+/// SIGINT during a long render: the process ends promptly with 128 + SIGINT, says so in one line,
+/// and leaves nothing behind in the output folder (no image, no temporary file).
+TEST(Cli, InterruptedRenderLeavesNoFile) {
+    const fs::path dir = fs::temp_directory_path() / ("whitted_cli_sigint_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const fs::path out = dir / "never.png";
+    const fs::path err = dir.parent_path() / ("whitted_cli_sigint_err_" + std::to_string(::getpid()) + ".txt");
+    const std::string scene = std::string(WHITTED_ASSETS_DIR) + "/scenes/glass_mirror_room.json";
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        std::FILE* e = std::freopen(err.c_str(), "w", stderr);
+        (void)e;
+        ::execl(WHITTED_EXE, WHITTED_EXE, "render", scene.c_str(), "--width", "1600", "--aa", "stratified", "--spp", "64",
+                "--no-progress", "-o", out.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    ::usleep(1500 * 1000);  // loaded and rendering (the render takes minutes)
+    ASSERT_EQ(::kill(pid, SIGINT), 0);
+    int status = 0;
+    pid_t done = 0;
+    for (int i = 0; i < 100 && done == 0; ++i) {  // up to 10 s
+        done = ::waitpid(pid, &status, WNOHANG);
+        if (done == 0) ::usleep(100 * 1000);
+    }
+    if (done == 0) {
+        ::kill(pid, SIGKILL);
+        ::waitpid(pid, &status, 0);
+        FAIL() << "whitted did not exit within 10 s of SIGINT";
+    }
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 128 + SIGINT);
+    const std::string text = slurp(err);
+    EXPECT_NE(text.find("interrupted"), std::string::npos) << text;
+    EXPECT_TRUE(fs::is_empty(dir)) << "left behind in " << dir;
+    fs::remove_all(dir);
+    fs::remove(err);
 }
 
 }  // namespace

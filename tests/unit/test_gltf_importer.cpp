@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <string>
 
@@ -127,6 +128,32 @@ TEST(GltfImporter, TexturedBoxDecodesItsTexture) {
     ASSERT_EQ(n.textures.size(), 1u);
     EXPECT_TRUE(n.textures[0].levels.empty());
     EXPECT_EQ(n.textures[0].image, 0);
+}
+
+/// glTF URIs are percent-encoded (RFC 3986): "Cesium%20Logo.png" names the file "Cesium Logo.png".
+TEST(GltfImporter, PercentEncodedUrisNameTheDecodedFile) {
+    namespace fs = std::filesystem;
+    const fs::path dir = scratch_dir() / "percent_uri";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const fs::path src = asset("BoxTextured/glTF");
+    fs::copy_file(src / "BoxTextured0.bin", dir / "Box Textured 0.bin");
+    fs::copy_file(src / "CesiumLogoFlat.png", dir / "Cesium Logo #1.png");
+    const std::vector<uint8_t> bytes = read_bytes((src / "BoxTextured.gltf").string());
+    std::string text(bytes.begin(), bytes.end());
+    auto replace = [&](const std::string& from, const std::string& to) {
+        const size_t at = text.find(from);
+        ASSERT_NE(at, std::string::npos) << from;
+        text.replace(at, from.size(), to);
+    };
+    replace("\"CesiumLogoFlat.png\"", "\"Cesium%20Logo%20%231.png\"");
+    replace("\"BoxTextured0.bin\"", "\"Box%20Textured%200.bin\"");
+    std::ofstream(dir / "box.gltf") << text;
+    const Scene s = load_scene((dir / "box.gltf").string());
+    ASSERT_EQ(s.textures.size(), 1u);
+    ASSERT_FALSE(s.textures[0].levels.empty());
+    EXPECT_EQ(s.textures[0].levels[0].width, 256);
+    EXPECT_EQ(s.meshes[0].triangle_count(), 12u);
 }
 
 TEST(GltfImporter, VertexColorsVec3GetAlphaOne) {
