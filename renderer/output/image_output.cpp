@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <thread>
+#include <chrono>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -423,6 +425,10 @@ void write_atomically(const EncodedImage& image, FileKind kind, const fs::path& 
         auto out = OIIO::ImageOutput::create(oiio_format_name(kind));
         if (!out) throw fail(OIIO::geterror());
         if (!out->open(temp.path().string(), image.spec)) throw fail(out->geterror());
+        // Test hook: hold the half-written temporary file for a while, so the CLI tests can
+        // interrupt a write in progress (tests/cli/test_cli.cpp). Unset in normal use.
+        if (const char* delay = std::getenv("WHITTED_TEST_WRITE_DELAY_MS"))
+            std::this_thread::sleep_for(std::chrono::milliseconds(std::clamp(std::atol(delay), 0L, 60000L)));
         if (!out->write_image(image.format, image.bytes.data())) {
             std::string reason = out->geterror();
             out->close();

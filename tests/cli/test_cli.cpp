@@ -247,4 +247,77 @@ TEST(Cli, InterruptedRenderLeavesNoFile) {
     fs::remove(err);
 }
 
+/// Starts `whitted render <Box> -o <dir>/out.png` with the write held open for `delay_ms`
+/// (WHITTED_TEST_WRITE_DELAY_MS) and returns the child's pid once its temporary file exists.
+pid_t start_slow_write(const fs::path& dir, const fs::path& err, int delay_ms) {
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        std::FILE* e = std::freopen(err.c_str(), "w", stderr);
+        (void)e;
+        ::setenv("WHITTED_TEST_WRITE_DELAY_MS", std::to_string(delay_ms).c_str(), 1);
+        const std::string out = (dir / "out.png").string();
+        ::execl(WHITTED_EXE, WHITTED_EXE, "render", kBox.c_str(), "--width", "32", "--no-progress", "-o", out.c_str(),
+                static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    // Wait (up to 20 s) for the temporary file: the write is then in progress.
+    for (int i = 0; i < 400; ++i) {
+        for (const auto& entry : fs::directory_iterator(dir))
+            if (entry.path().filename().string().rfind(".out.tmp-", 0) == 0) return pid;
+        ::usleep(50 * 1000);
+    }
+    return pid;
+}
+
+/// Waits up to `seconds` for `pid`; returns its exit code, or -1 when it was still running (then
+/// it is killed).
+int wait_exit(pid_t pid, double seconds) {
+    int status = 0;
+    for (int i = 0; i < int(seconds * 20); ++i) {
+        if (::waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        ::usleep(50 * 1000);
+    }
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+    return -1;
+}
+
+/// One SIGINT while the image is being written: the write completes (a whole file, never a
+/// half-written one), then the run exits with 128 + SIGINT.
+TEST(Cli, SigintDuringWriteFinishesTheFileThenExits) {
+    const fs::path dir = fs::temp_directory_path() / ("whitted_cli_wr1_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const fs::path err = dir.string() + ".err";
+    const pid_t pid = start_slow_write(dir, err, 2000);
+    ASSERT_GT(pid, 0);
+    ::kill(pid, SIGINT);
+    EXPECT_EQ(wait_exit(pid, 20.0), 128 + SIGINT);
+    EXPECT_TRUE(fs::exists(dir / "out.png"));
+    size_t files = 0;
+    for (const auto& entry : fs::directory_iterator(dir)) files += entry.is_regular_file() ? 1 : 0;
+    EXPECT_EQ(files, 1u) << "only the finished image remains";
+    EXPECT_NE(slurp(err).find("before exiting"), std::string::npos) << slurp(err);
+    fs::remove_all(dir);
+    fs::remove(err);
+}
+
+/// A second SIGINT during the write ends the run at once and removes the temporary file.
+TEST(Cli, SecondSigintDuringWriteExitsAtOnceAndLeavesNoFile) {
+    const fs::path dir = fs::temp_directory_path() / ("whitted_cli_wr2_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const fs::path err = dir.string() + ".err";
+    const pid_t pid = start_slow_write(dir, err, 30000);
+    ASSERT_GT(pid, 0);
+    ::kill(pid, SIGINT);
+    ::usleep(200 * 1000);
+    ::kill(pid, SIGINT);
+    // "At once": far sooner than the 30 s the write is held.
+    EXPECT_EQ(wait_exit(pid, 5.0), 128 + SIGINT);
+    EXPECT_TRUE(fs::is_empty(dir)) << "no image and no temporary file";
+    fs::remove_all(dir);
+    fs::remove(err);
+}
+
 }  // namespace
