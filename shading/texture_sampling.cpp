@@ -298,10 +298,14 @@ Color sample_checker(const Checker& c, Vec2f uv, const Vec3f& p, const Vec3f& n,
     // is (1 + product) / 2.
     double product = 1.0;
     if (c.world_space) {
-        // 3D solid checker, evaluated a tiny step inside the surface so points on a face lying on
+        // 3D solid checker, evaluated a small step inside the surface so points on a face lying on
         // a cell boundary all pick the same cell. The footprint lies in the tangent plane: its
         // extent along world axis i is w sqrt(1 - n_i^2) (0 along a face's own normal).
-        const Vec3d q = Vec3d(p - n * (1e-4f * c.size)) * inv;
+        // The step must also exceed the hit point's own rounding error (a few ulps of its largest
+        // coordinate), or far from the origin the point falls on either side of the face at random.
+        const float p_max = std::max(std::fabs(p.x), std::max(std::fabs(p.y), std::fabs(p.z)));
+        const float step = std::max(1e-4f * c.size, 16.f * p_max * std::numeric_limits<float>::epsilon());
+        const Vec3d q = (Vec3d(p) - Vec3d(n) * double(step)) * inv;
         if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) return c.color_a;
         for (int i = 0; i < 3; ++i)
             product *= filtered_square_wave(q[i], w * std::sqrt(std::max(0.0, 1.0 - double(n[i]) * double(n[i]))));

@@ -26,8 +26,9 @@ Vec4f sample_texture(const Texture& texture, Vec2f uv, float lod = 0.f);
 /// units for world-space checkers; 0 = point sample): UV-space checkers are box-filtered over it
 /// in closed form (integral of the square wave, as pbrt-v3's Checkerboard2DTexture), so distant
 /// squares fade to the mean color instead of aliasing; footprints of 2 squares or more return the
-/// mean. World-space checkers are point-sampled a tiny step (1e-4 size) inside the surface, so
-/// faces lying on a cell boundary pick one cell.
+/// mean. World-space checkers are evaluated a small step inside the surface (1e-4 size, or 16 ulps
+/// of the point's largest coordinate when that is more), so faces lying on a cell boundary pick
+/// one cell wherever they are.
 Color sample_checker(const Checker& checker, Vec2f uv, const Vec3f& p, const Vec3f& n, float width = 0.f);
 
 /// Fills texture.levels[1..] from levels[0] by 2x2 box filtering in linear space.

@@ -368,6 +368,17 @@ TEST(Checker, WorldSpaceFloorOnCellBoundaryDoesNotFlicker) {
     }
 }
 
+TEST(Checker, WorldSpaceFloorFarFromTheOriginDoesNotFlicker) {
+    // At x = 1e3 a float hit point on the floor y = 0 may be off the plane by a few ulps of 1e3
+    // (about 1e-4), more than a step of 1e-4 * size = 5e-5: the step must scale with |p|.
+    const Checker c = red_yellow(true);
+    const Vec3f up{0.f, 1.f, 0.f};
+    const float ulp = 1000.f * std::numeric_limits<float>::epsilon();
+    for (float dy : {0.f, 3.f * ulp, -3.f * ulp})
+        EXPECT_EQ(sample_checker(c, {}, {1000.1f, dy, 2000.1f}, up), sample_checker(c, {}, {1000.1f, 0.f, 2000.1f}, up))
+            << dy;
+}
+
 TEST(Checker, BoxFilterMatchesNumericalAverage) {
     // The closed-form filtered checker equals the average of point samples over the footprint
     // square [u - w/2, u + w/2] x [v - w/2, v + w/2].
