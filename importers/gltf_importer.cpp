@@ -33,6 +33,7 @@
 #include "importers/gltf_json.h"
 #include "importers/gltf_validation.h"
 #include "importers/image_decode.h"
+#include "importers/mesh_numbers.h"
 #include "importers/scene_defaults.h"
 #include "importers/scene_loader.h"
 #include "importers/warning_log.h"
@@ -1113,6 +1114,7 @@ private:
                 if (m_requests[it->second].mirrored != k.mirrored) mirror(mesh);
             } else {
                 mesh = build_geometry(p, ptr);
+                report_mesh_numbers(sanitize_mesh_numbers(mesh), ptr, m_warnings);
                 if (k.mirrored) mirror(mesh);
                 decoded.emplace(gkey, uint32_t(m_scene.meshes.size()));
             }

@@ -25,6 +25,7 @@
 #include <fmt/format.h>
 
 #include "importers/image_decode.h"
+#include "importers/mesh_numbers.h"
 #include "importers/scene_defaults.h"
 #include "importers/scene_file_geometry.h"
 #include "importers/scene_file_image.h"
@@ -822,7 +823,10 @@ private:
         if (const Json* uv = member(o, "uvs")) {
             mesh.uv0.resize(tuple_count(*uv, 2));
             const size_t n = read_tuples(*uv, sub(ptr, "uvs"), 2, "uvs", [&](size_t i, const double* x) {
-                if (i < mesh.uv0.size()) mesh.uv0[i] = {float(x[0]), float(x[1])};
+                if (i >= mesh.uv0.size()) return;
+                mesh.uv0[i] = {float(x[0]), float(x[1])};
+                if (!std::isfinite(mesh.uv0[i].x) || !std::isfinite(mesh.uv0[i].y))
+                    fail(sub(sub(ptr, "uvs"), i), "uv out of the float range");
             });
             check_count("uvs", n);
         }
@@ -834,8 +838,10 @@ private:
             else if (col->is_array() && col->size() == nv * 4) comps = 4;
             mesh.colors.resize(tuple_count(*col, size_t(comps)));
             const size_t n = read_tuples(*col, cp, comps, comps == 4 ? "RGBA colors" : "RGB colors", [&](size_t i, const double* x) {
-                if (i < mesh.colors.size())
-                    mesh.colors[i] = {float(x[0]), float(x[1]), float(x[2]), comps == 4 ? float(x[3]) : 1.f};
+                if (i >= mesh.colors.size()) return;
+                mesh.colors[i] = {float(x[0]), float(x[1]), float(x[2]), comps == 4 ? float(x[3]) : 1.f};
+                if (!is_finite(mesh.colors[i].xyz()) || !std::isfinite(mesh.colors[i].w))
+                    fail(sub(cp, i), "color out of the float range");
             });
             check_count("colors", n);
         }
@@ -851,6 +857,7 @@ private:
                   bool counted = false) {
         if (!counted) reserve(mesh_bytes(mesh.positions.size(), mesh.indices.size(), 2 * sizeof(Vec3f) + sizeof(Vec2f)), ptr);
         if (world.det3() < 0) flip_winding(mesh);
+        report_mesh_numbers(sanitize_mesh_numbers(mesh), ptr, m_warnings);
         mesh.name = name;
         mesh.material = material;
         Instance inst;

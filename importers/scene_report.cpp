@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "renderer/scene/scene_analysis.h"
 #include "shading/material_mapping.h"
 
 namespace whitted {
@@ -238,6 +239,42 @@ std::string describe_scene(const Scene& scene) {
         line(fmt::format("extension: {} {} required={} note=\"{}\"", e.name, support_name(e.support),
                          yes_no(e.required), e.note));
     for (const std::string& w : scene.warnings) line("warning: " + w);
+    out += describe_analysis(scene, analyze_scene(scene));
+    return out;
+}
+
+std::string describe_analysis(const Scene& scene, const SceneAnalysis& a) {
+    std::string out;
+    auto line = [&](const std::string& s) {
+        out += s;
+        out += '\n';
+    };
+    const SceneFeatures& f = a.features;
+    line(fmt::format("analysis: opaque={} recursive={} mirror={} transmission={} alpha_blend={} alpha_mask={} "
+                     "textured={} vertex_colors={} varying={} emissive={} unlit={} volume={} single_sided={} "
+                     "highlight={} diffuse={}",
+                     yes_no(f.opaque()), yes_no(f.recursive()), yes_no(f.mirror), yes_no(f.transmission),
+                     yes_no(f.alpha_blend), yes_no(f.alpha_mask), yes_no(f.textured), yes_no(f.vertex_colors),
+                     yes_no(f.varying), yes_no(f.emissive), yes_no(f.unlit), yes_no(f.volume), yes_no(f.single_sided),
+                     yes_no(f.highlight), yes_no(f.diffuse)));
+    const double per_tri = a.triangles ? double(a.scene_bytes) / double(a.triangles) : 0.0;
+    line(fmt::format("analysis memory: triangles={} scene_bytes={} bytes_per_triangle={} texture_bytes={}", a.triangles,
+                     a.scene_bytes, num(per_tri), a.texture_bytes));
+    for (size_t i = 0; i < a.materials.size(); ++i) {
+        const MaterialFeatures& m = a.materials[i];
+        line(fmt::format("analysis material[{}]: used={} diffuse={} highlight={} mirror={} transmission={} emissive={} "
+                         "unlit={} textured={} vertex_colors={} alpha_mask={} alpha_blend={} volume={} "
+                         "single_sided={} varying={}",
+                         i, yes_no(m.used), yes_no(m.diffuse), yes_no(m.highlight), yes_no(m.mirror),
+                         yes_no(m.transmission), yes_no(m.emissive), yes_no(m.unlit), yes_no(m.textured),
+                         yes_no(m.vertex_colors), yes_no(m.alpha_mask), yes_no(m.alpha_blend), yes_no(m.volume),
+                         yes_no(m.single_sided), yes_no(m.varying)));
+    }
+    for (size_t i = 0; i < a.lights.size() && i < scene.lights.size(); ++i) {
+        const LightReach& r = a.lights[i];
+        line(fmt::format("analysis light[{}]: reach={}/{} culled_range={} culled_cone={} facing=per-point", i,
+                         r.objects_reached, a.object_count, r.culled_range, r.culled_cone));
+    }
     return out;
 }
 

@@ -30,9 +30,12 @@
 namespace whitted::app {
 Command register_bench_aa(CLI::App& bench);  ///< `whitted bench aa` (apps/whitted/bench_aa.cpp)
 Command register_bench_accel(CLI::App& bench);  ///< `whitted bench accel` (apps/whitted/bench_accel.cpp)
+Command register_bench_skip(CLI::App& bench);  ///< `whitted bench skip` (apps/whitted/bench_skip.cpp)
+Command register_bench_stability(CLI::App& bench);  ///< `whitted bench stability` (apps/whitted/bench_stability.cpp)
 }  // namespace whitted::app
 using whitted::app::register_bench_aa;
 using whitted::app::register_bench_accel;
+using whitted::app::register_bench_skip;
 
 namespace {
 
@@ -119,8 +122,9 @@ struct RenderOptions {
     std::string aa = "adaptive", filter = "box";
     float aa_threshold = AaSettings{}.threshold;
     int aa_depth = AaSettings{}.depth, spp = AaSettings{}.spp;
-    float exposure = 0.f, mirror_cutoff = 0.3f, min_weight = 0.f;
+    float exposure = 0.f, mirror_cutoff = 0.3f, min_weight = 1.f / 255.f;
     bool fresnel = false, refract_thin = false, robust = false, no_progress = false, exr_float = false;
+    bool no_specialize = false;
     double max_memory_gb = 8.0;
     bool allow_outside_uris = false;
 };
@@ -177,6 +181,7 @@ int run_render(RenderOptions o, const std::string& cmdline, Given&& given) {
     rs.integrator.ambient = parse_color(o.ambient, "--ambient");
     rs.integrator.fresnel = o.fresnel;
     rs.integrator.min_weight = o.min_weight;
+    rs.integrator.specialize = !o.no_specialize;
     rs.mapping.refract_thin = o.refract_thin;
     rs.mapping.mirror_roughness_cutoff = o.mirror_cutoff;
     rs.exposure = std::exp2(o.exposure);
@@ -206,6 +211,19 @@ int run_render(RenderOptions o, const std::string& cmdline, Given&& given) {
              scene.instanced_triangle_count(), scene.instances.size(), scene.lights.size(), o.camera,
              scene.cameras.size(), scene.cameras[size_t(o.camera)].is_default ? " (default)" : "", size.width,
              size.height);
+    // What the scene uses and what the renderer skips (docs/performance.md).
+    {
+        std::istringstream analysis(describe_analysis(scene, renderer.view().analysis()));
+        // Per-material lines, and per-light lines of scenes with many lights, at debug level.
+        const bool many_lights = scene.lights.size() > 16;
+        for (std::string l; std::getline(analysis, l);) {
+            if (l.rfind("analysis material[", 0) == 0 || (many_lights && l.rfind("analysis light[", 0) == 0))
+                log_debug("{}", l);
+            else
+                log_info("{}", l);
+        }
+        log_info("kernel: {}", kernel_name(renderer.kernel()));
+    }
     RenderStats stats;
     Film film = renderer.render(&stats);
 
@@ -237,12 +255,17 @@ int run_render(RenderOptions o, const std::string& cmdline, Given&& given) {
                  "whitted: wrote %s (%dx%d)\n"
                  "  time   load %.3fs  build %.3fs  render %.3fs  write %.3fs\n"
                  "  rays   camera %llu  shadow %llu  reflection %llu  refraction %llu  total %llu\n"
+                 "  skip   %s; shadow rays not cast: %llu unreached, %llu facing away; "
+                 "secondary rays below --min-weight %g: %llu\n"
                  "  speed  %.2f Mrays/s on %d threads\n"
                  "  aa     %s: %.3f camera rays/pixel, %.1f%% pixels subdivided\n",
                  o.output.c_str(), film.width(), film.height(), load_s, stats.build_seconds, stats.render_seconds,
                  write_s, (unsigned long long)stats.rays.camera, (unsigned long long)stats.rays.shadow,
                  (unsigned long long)stats.rays.reflection, (unsigned long long)stats.rays.refraction,
-                 (unsigned long long)rays, mrays, stats.threads, o.aa.c_str(),
+                 (unsigned long long)rays, kernel_name(renderer.kernel()).c_str(),
+                 (unsigned long long)stats.rays.shadow_skipped_unreached,
+                 (unsigned long long)stats.rays.shadow_skipped_facing, double(o.min_weight),
+                 (unsigned long long)stats.rays.secondary_skipped_cutoff, mrays, stats.threads, o.aa.c_str(),
                  stats.pixels ? double(stats.rays.camera) / double(stats.pixels) : 0.0, 100.0 * subdivided);
     return 0;
 }
@@ -290,9 +313,11 @@ int main(int argc, char** argv) {
     render->add_option("--exposure", ro.exposure, "Exposure in stops: radiance is scaled by 2^exposure")
         ->capture_default_str();
     render->add_option("--min-weight", ro.min_weight,
-                       "Adaptive tree depth: skip reflected/refracted rays whose accumulated weight is below this "
-                       "(0 = trace to --max-depth)")
+                       "Adaptive tree depth (Hall & Greenberg 1983): skip reflected/refracted rays whose accumulated "
+                       "weight is below this (default 1/255; 0 = trace to --max-depth)")
         ->check(CLI::Range(0.0f, 1.0f))->capture_default_str();
+    render->add_flag("--no-specialize", ro.no_specialize,
+                     "Use the general shading kernel instead of the one the scene needs (to measure the gain)");
     render->add_flag("--fresnel", ro.fresnel, "Weight reflection and transmission with Schlick's Fresnel term");
     render->add_flag("--refract-thin", ro.refract_thin,
                      "Refract through transmissive materials without KHR_materials_volume (classic glass)");
@@ -352,6 +377,8 @@ int main(int argc, char** argv) {
     // Each benchmark module registers itself here (one line each):
     commands.push_back(register_bench_aa(*bench));
     commands.push_back(register_bench_accel(*bench));
+    commands.push_back(register_bench_skip(*bench));
+    commands.push_back(whitted::app::register_bench_stability(*bench));
 
     // Global options (--log-level) may also follow the subcommand.
     render->fallthrough();

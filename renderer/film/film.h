@@ -52,6 +52,13 @@ struct Film {
     int height() const { return window.height(); }
     /// Index of full-image pixel (x, y), which must lie inside the window.
     size_t index(int x, int y) const { return size_t(y - window.y0) * size_t(width()) + size_t(x - window.x0); }
+    /// NaN or infinite values in the beauty, normal and albedo buffers (depth is +inf for misses
+    /// by design and not counted).
+    size_t nonfinite_values() const;
+    /// Last line of defence before output: replaces every NaN / infinite beauty, normal or albedo
+    /// component by 0 and returns how many there were. Debug builds treat any as a bug (RT_DCHECK
+    /// throws whitted::Error); release builds count and repair (docs/numerical-stability.md).
+    size_t sanitize_nonfinite();
 };
 
 }  // namespace whitted

@@ -28,6 +28,8 @@ CameraModel::CameraModel(const Camera& camera, int width, int height)
     m_up = normalize(m.apply_vector({0, 1, 0}));
     m_forward = normalize(m.apply_vector({0, 0, -1}));
     const double image_aspect = double(width) / double(height);
+    m_ndc_x = 2.0 / double(width);
+    m_ndc_y = 2.0 / double(height);
     if (m_type == CameraType::Perspective) {
         m_half_h = std::tan(camera.yfov * 0.5);
         m_half_w = m_half_h * image_aspect;
@@ -40,19 +42,20 @@ CameraModel::CameraModel(const Camera& camera, int width, int height)
 }
 
 Ray CameraModel::generate(double x, double y) const {
-    // Normalized device coordinates in [-1, 1], +y up.
-    const double sx = (2.0 * x / m_width - 1.0) * m_half_w;
-    const double sy = (1.0 - 2.0 * y / m_height) * m_half_h;
+    // Normalized device coordinates in [-1, 1], +y up. One division per ray (the reciprocal of
+    // the length): this runs once per camera sample, next to a cheap Embree miss for background.
+    const double sx = (x * m_ndc_x - 1.0) * m_half_w;
+    const double sy = (1.0 - y * m_ndc_y) * m_half_h;
     Ray r;
     if (m_type == CameraType::Perspective) {
         Vec3d d = m_forward + m_right * sx + m_up * sy;
         const double len = length(d);
         r.org = Vec3f(m_origin);
-        r.dir = Vec3f(d / len);
-        // Near and far planes are distances along the view axis: convert to distances on the ray.
-        const double cos_axis = 1.0 / len;
-        r.tnear = float(m_znear / cos_axis);
-        r.tfar = m_zfar > 0 ? float(m_zfar / cos_axis) : kInfinity;
+        r.dir = Vec3f(d * (1.0 / len));
+        // Near and far planes are distances along the view axis: convert to distances on the ray
+        // (divide by the cosine to the axis, 1 / len).
+        r.tnear = float(m_znear * len);
+        r.tfar = m_zfar > 0 ? float(m_zfar * len) : kInfinity;
     } else {
         r.org = Vec3f(m_origin + m_right * sx + m_up * sy);
         r.dir = Vec3f(m_forward);

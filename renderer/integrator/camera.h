@@ -33,6 +33,7 @@ private:
     Vec3d m_origin, m_right, m_up, m_forward;  ///< world-space camera frame (unit axes)
     double m_half_w = 1, m_half_h = 1;         ///< image-plane half extents at distance 1 (or ortho mags)
     double m_znear = 0, m_zfar = 0;
+    double m_ndc_x = 0, m_ndc_y = 0;           ///< 2 / width, 2 / height
     int m_width, m_height;
 };
 

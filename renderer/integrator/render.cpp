@@ -367,10 +367,16 @@ private:
 Film Renderer::render(RenderStats* stats) const { return render(m_settings.aa, stats); }
 
 Film Renderer::render(const AaSettings& aa, RenderStats* stats) const {
+    return render(aa, m_settings.integrator, *m_accel, stats);
+}
+
+Film Renderer::render(const AaSettings& aa, const IntegratorSettings& settings, const Accelerator& accel,
+                      RenderStats* stats) const {
     validate_aa_settings(aa);
+    if (settings.max_depth < 0) throw Error(fmt::format("--max-depth must be >= 0 (got {})", settings.max_depth));
     const Camera& cam = m_scene.cameras[size_t(m_settings.camera)];
     const CameraModel camera(cam, m_size.width, m_size.height);
-    const WhittedIntegrator integrator(m_view, *m_accel, m_settings.integrator);
+    const WhittedIntegrator integrator(m_view, accel, settings);
     Film film(m_size.width, m_size.height, m_window, m_settings.aovs);
     Frame frame(camera, integrator, film, aa, m_settings.exposure);
 

@@ -56,6 +56,13 @@ public:
     /// Renders with another anti-aliasing setting (benchmarks sweep settings on one accelerator).
     /// Throws whitted::Error when `aa` is out of range.
     Film render(const AaSettings& aa, RenderStats* stats = nullptr) const;
+    /// Renders with other integrator settings (depth, min_weight, specialize...) on the same
+    /// accelerator and tracing every ray through `accel` (e.g. a decorator of accelerator() that
+    /// records rays; it must answer for this renderer's scene and view). Benchmarks only.
+    Film render(const AaSettings& aa, const IntegratorSettings& integrator, const Accelerator& accel,
+                RenderStats* stats = nullptr) const;
+    /// The shading kernel render() uses (select_kernel on the scene analysis and the settings).
+    KernelFeatures kernel() const { return select_kernel(m_view.analysis().features, m_settings.integrator); }
 
     ImageSize image_size() const { return m_size; }
     const Accelerator& accelerator() const { return *m_accel; }

@@ -66,7 +66,8 @@ constexpr float kNoFootprint[2] = {-kInfinity, -kInfinity};
 
 }  // namespace
 
-SceneView::SceneView(const Scene& scene, const MappingOptions& mapping) : m_scene(scene), m_mapping(mapping) {
+SceneView::SceneView(const Scene& scene, const MappingOptions& mapping)
+    : m_scene(scene), m_mapping(mapping), m_analysis(analyze_scene(scene, mapping)) {
     // Float transforms per instance; the normal matrix is inverted in double precision.
     m_xf.resize(scene.instances.size());
     for (size_t i = 0; i < scene.instances.size(); ++i) {
@@ -104,10 +105,11 @@ Vec3f SceneView::world_geometric_normal(const Hit& hit) const {
     return cross(p1 - p0, p2 - p0);
 }
 
+template <bool kAttributes>
 SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& cone) const {
     switch (m_scene.geom_kind(hit.geom)) {
-        case GeomKind::Sphere: return sphere_surface(ray, hit, cone);
-        case GeomKind::Plane: return plane_surface(ray, hit, cone);
+        case GeomKind::Sphere: return sphere_surface<kAttributes>(ray, hit, cone);
+        case GeomKind::Plane: return plane_surface<kAttributes>(ray, hit, cone);
         case GeomKind::Mesh: break;
     }
     SurfacePoint sp;
@@ -143,27 +145,30 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
     if (ng == Vec3f(0.f)) ng = normalize(-ray.dir);  // degenerate triangle: face the ray
     sp.ng = ng;
 
-    if (!mesh.uv0.empty()) sp.uv[0] = interpolate(mesh.uv0, i0, i1, i2, u, v);
-    if (!mesh.uv1.empty()) sp.uv[1] = interpolate(mesh.uv1, i0, i1, i2, u, v);
-    if (!mesh.colors.empty()) sp.color = interpolate(mesh.colors, i0, i1, i2, u, v);
+    // Texture and vertex-color inputs: skipped when nothing in the scene varies over a surface.
+    if constexpr (kAttributes) {
+        if (!mesh.uv0.empty()) sp.uv[0] = interpolate(mesh.uv0, i0, i1, i2, u, v);
+        if (!mesh.uv1.empty()) sp.uv[1] = interpolate(mesh.uv1, i0, i1, i2, u, v);
+        if (!mesh.colors.empty()) sp.color = interpolate(mesh.colors, i0, i1, i2, u, v);
 
-    // Texture footprint (Akenine-Moeller et al. 2019, ray cones): the cone's width at the hit,
-    // stretched by 1/|cos| on the surface, converted to UV units by sqrt(uv area / world area)
-    // of the triangle (its UV parameterisation's mean scale). Isotropic: no anisotropic filtering.
-    const float width = cone.width_at(hit.t);
-    if (width > 0.f) {
-        const float world_area = length(cross(p1 - p0, p2 - p0));
-        const float cos_theta = std::max(std::abs(dot(ng, ray.dir)), 1e-3f);
-        sp.footprint = width / cos_theta;
-        auto footprint = [&](const std::vector<Vec2f>& uvs) {
-            const Vec2f a = uvs[i0], b = uvs[i1], c = uvs[i2];
-            const float uv_area = std::abs((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y));
-            if (!(uv_area > 0.f) || !(world_area > 0.f)) return -kInfinity;
-            const float lod = std::log2(width / cos_theta) + 0.5f * std::log2(uv_area / world_area);
-            return std::isfinite(lod) ? lod : -kInfinity;
-        };
-        if (!mesh.uv0.empty()) sp.uv_lod[0] = footprint(mesh.uv0);
-        if (!mesh.uv1.empty()) sp.uv_lod[1] = footprint(mesh.uv1);
+        // Texture footprint (Akenine-Moeller et al. 2019, ray cones): the cone's width at the hit,
+        // stretched by 1/|cos| on the surface, converted to UV units by sqrt(uv area / world area)
+        // of the triangle (its UV parameterisation's mean scale). Isotropic: no anisotropic filtering.
+        const float width = cone.width_at(hit.t);
+        if (width > 0.f) {
+            const float world_area = length(cross(p1 - p0, p2 - p0));
+            const float cos_theta = std::max(std::abs(dot(ng, ray.dir)), 1e-3f);
+            sp.footprint = width / cos_theta;
+            auto footprint = [&](const std::vector<Vec2f>& uvs) {
+                const Vec2f a = uvs[i0], b = uvs[i1], c = uvs[i2];
+                const float uv_area = std::abs((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y));
+                if (!(uv_area > 0.f) || !(world_area > 0.f)) return -kInfinity;
+                const float lod = std::log2(width / cos_theta) + 0.5f * std::log2(uv_area / world_area);
+                return std::isfinite(lod) ? lod : -kInfinity;
+            };
+            if (!mesh.uv0.empty()) sp.uv_lod[0] = footprint(mesh.uv0);
+            if (!mesh.uv1.empty()) sp.uv_lod[1] = footprint(mesh.uv1);
+        }
     }
 
     // Shading normal: interpolated vertex normals, then the normal map.
@@ -173,7 +178,7 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
         if (n != Vec3f(0.f) && is_finite(n)) ns = n;
     }
     const Material& mat = m_scene.materials[mesh.material];
-    if (mat.normal_texture.valid() && !mesh.tangents.empty() && mat.model == MaterialModel::GltfPbr) {
+    if (kAttributes && mat.normal_texture.valid() && !mesh.tangents.empty() && mat.model == MaterialModel::GltfPbr) {
         Vec4f t4 = interpolate(mesh.tangents, i0, i1, i2, u, v);
         Vec3f t = xf_vector(xf.m, t4.xyz());
         t = normalize(t - ns * dot(ns, t));  // Gram-Schmidt against the shading normal
@@ -190,6 +195,7 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
     return sp;
 }
 
+template <bool kAttributes>
 SurfacePoint SceneView::sphere_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const {
     const Sphere& sphere = m_scene.spheres[hit.geom - m_scene.meshes.size()];
     SurfacePoint sp;
@@ -204,6 +210,7 @@ SurfacePoint SceneView::sphere_surface(const Ray& ray, const Hit& hit, const Ray
     sp.p = Vec3f(sphere.center + n * sphere.radius);
     sp.p_shadow = sp.p;
     sp.ng = sp.ns = normalize(Vec3f(n));
+    if constexpr (!kAttributes) return sp;
     // Longitude about +Y and colatitude from the +Y pole (scene.h: Sphere).
     const double u = std::atan2(n.x, n.z) / (2.0 * kPiD) + 0.5;
     const double v = std::acos(std::clamp(n.y, -1.0, 1.0)) / kPiD;
@@ -222,6 +229,7 @@ SurfacePoint SceneView::sphere_surface(const Ray& ray, const Hit& hit, const Ray
     return sp;
 }
 
+template <bool kAttributes>
 SurfacePoint SceneView::plane_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const {
     const Plane& plane = m_scene.planes[hit.geom - m_scene.meshes.size() - m_scene.spheres.size()];
     SurfacePoint sp;
@@ -233,6 +241,7 @@ SurfacePoint SceneView::plane_surface(const Ray& ray, const Hit& hit, const RayC
     sp.p = Vec3f(p);
     sp.p_shadow = sp.p;
     sp.ng = sp.ns = Vec3f(plane.normal);
+    if constexpr (!kAttributes) return sp;
     const Vec3d rel = p - plane.point;
     const Vec3d v_axis = cross(plane.normal, plane.u_axis);
     sp.uv[0] = sp.uv[1] = Vec2f{float(dot(rel, plane.u_axis)), float(dot(rel, v_axis))};
@@ -328,5 +337,8 @@ Color SceneView::transmittance(const Ray& ray, const Hit& hit) const {
     // BLEND: the uncovered fraction passes untouched, the covered part passes through Kt.
     return Color(1.f - coverage) + kt * coverage;
 }
+
+template SurfacePoint SceneView::surface<true>(const Ray&, const Hit&, const RayCone&) const;
+template SurfacePoint SceneView::surface<false>(const Ray&, const Hit&, const RayCone&) const;
 
 }  // namespace whitted

@@ -1,12 +1,15 @@
-// SceneView: the render-time view of a Scene. Precomputes per-instance float transforms and
-// per-mesh flags, turns a minimal Hit into a SurfacePoint (position, normals, UVs, colors) and
-// evaluates materials there. It is also the SurfaceFilter backends consult during traversal.
+// SceneView: the render-time view of a Scene. Precomputes per-instance float transforms,
+// per-mesh flags and the SceneAnalysis (what the scene uses, which lights reach which object),
+// turns a minimal Hit into a SurfacePoint (position, normals, UVs, colors) and evaluates
+// materials there. It is also the SurfaceFilter backends consult during traversal.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/scene/scene.h"
+#include "renderer/scene/scene_analysis.h"
 #include "shading/material_mapping.h"
 
 namespace whitted {
@@ -42,8 +45,13 @@ class SceneView final : public SurfaceFilter {
 public:
     SceneView(const Scene& scene, const MappingOptions& mapping);
 
-    /// Full surface data at a hit of unit-direction `ray`; `cone` is the ray's footprint, which
+    /// Surface data at a hit of unit-direction `ray`; `cone` is the ray's footprint, which
     /// selects texture MIP levels (the default point cone samples the finest level).
+    /// kAttributes = false skips what only textures and vertex colors need (UVs, COLOR_0, the
+    /// footprint, normal maps): p, p_shadow, ng and ns are the same, uv/color/uv_lod/footprint
+    /// keep their defaults. Only valid when no material the hit can use is varying
+    /// (SceneAnalysis::features.varying is false).
+    template <bool kAttributes = true>
     SurfacePoint surface(const Ray& ray, const Hit& hit, const RayCone& cone = {}) const;
     /// Material inputs at a point (factors x textures x vertex color).
     PbrSample material_inputs(const Material& material, const SurfacePoint& sp) const;
@@ -51,6 +59,12 @@ public:
     WhittedCoeffs coefficients(const SurfacePoint& sp) const;
     const Scene& scene() const { return m_scene; }
     const MappingOptions& mapping() const { return m_mapping; }
+    /// What the scene uses, analysed with this view's mapping options.
+    const SceneAnalysis& analysis() const { return m_analysis; }
+    /// The lights that may reach the object hit (SceneAnalysis::lights_of), ascending.
+    std::span<const uint32_t> lights_reaching(const Hit& hit) const {
+        return m_analysis.lights_of(object_index(m_scene, hit.geom, hit.inst));
+    }
 
     // SurfaceFilter
     bool accept(const Ray& ray, const Hit& hit, RayKind kind) const override;
@@ -61,7 +75,9 @@ private:
     /// Coverage alpha at a hit (base color alpha x texture x vertex alpha), UV0/UV1 interpolated.
     float alpha_at(const Material& m, const Hit& hit) const;
     Vec3f world_geometric_normal(const Hit& hit) const;
+    template <bool kAttributes>
     SurfacePoint sphere_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const;
+    template <bool kAttributes>
     SurfacePoint plane_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const;
 
     struct InstanceXf {
@@ -72,6 +88,10 @@ private:
     MappingOptions m_mapping;
     std::vector<InstanceXf> m_xf;
     std::vector<uint32_t> m_mesh_flags;
+    SceneAnalysis m_analysis;
 };
+
+extern template SurfacePoint SceneView::surface<true>(const Ray&, const Hit&, const RayCone&) const;
+extern template SurfacePoint SceneView::surface<false>(const Ray&, const Hit&, const RayCone&) const;
 
 }  // namespace whitted

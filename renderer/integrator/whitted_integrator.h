@@ -1,7 +1,15 @@
 // The Whitted (1980) ray tree: local model plus recursive reflection and refraction.
+//
+// The shading kernel is a template on KernelFeatures: the Renderer's integrator picks one
+// instantiation per render from the SceneAnalysis (opaque scenes get a kernel without the
+// transmittance path, scenes without mirrors or glass one that never recurses, untextured scenes
+// one without UVs or texture lookups), so the hot path carries no per-ray feature branches.
+// IntegratorSettings::specialize = false forces the general kernel (--no-specialize); with
+// min_weight 0 both give bit-identical images (tests/render/test_specialization.cpp).
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/integrator/scene_view.h"
@@ -16,18 +24,46 @@ struct IntegratorSettings {
     float min_weight = 0.f;            ///< adaptive tree depth (Hall & Greenberg 1983): a secondary ray
                                        ///< is traced only while the product of the kr/kt weights along
                                        ///< its path (max over channels) is >= this; 0 = depth limit only
+                                       ///< (the CLI's default is 1/255, docs/integrator.md)
+    bool specialize = true;            ///< pick the kernel the scene needs; false = the general kernel
 };
+
+/// The compile-time feature set of a shading kernel (one instantiation per combination used).
+struct KernelFeatures {
+    bool attributes = true;    ///< UVs, vertex colors, ray-cone footprints, per-hit material evaluation
+    bool mirror = true;        ///< reflection rays (also total internal reflection)
+    bool transmission = true;  ///< refraction, alpha blend, absorption, shadow transmittance products
+    bool tables = false;       ///< constant materials from a table, per-object light lists
+    constexpr bool operator==(const KernelFeatures&) const = default;
+};
+
+/// The kernel that handles every scene: all features, no tables (--no-specialize).
+constexpr KernelFeatures kGeneralKernel{};
+
+/// The smallest kernel that renders a scene with these features exactly like the general one.
+KernelFeatures select_kernel(const SceneFeatures& scene, const IntegratorSettings& settings);
+
+/// "general" or e.g. "specialised: opaque, no recursion, constant materials" (for logs).
+std::string kernel_name(const KernelFeatures& k);
 
 /// Rays traced, by kind (summed per thread, then added: integer sums are deterministic).
 /// `camera` counts the primary rays whose radiance enters the image (the anti-aliasing samples);
 /// `aov_probe` counts first-hit-only rays through pixel centres that feed AOVs in modes without a
-/// centre sample.
+/// centre sample. The `*_skipped` counters are not rays: shadow rays not cast because the light
+/// cannot reach the point (beyond its range, outside its cone or culled per object by the scene
+/// analysis: `unreached`) or lies behind the surface (N.L <= 0: `facing`), and secondary rays
+/// not traced because their weight fell below min_weight (`cutoff`).
 struct RayCounters {
     uint64_t camera = 0, shadow = 0, reflection = 0, refraction = 0, aov_probe = 0;
+    uint64_t shadow_skipped_unreached = 0, shadow_skipped_facing = 0, secondary_skipped_cutoff = 0;
     uint64_t total() const { return camera + shadow + reflection + refraction + aov_probe; }
+    uint64_t secondary() const { return reflection + refraction; }
     RayCounters& operator+=(const RayCounters& o) {
         camera += o.camera; shadow += o.shadow; reflection += o.reflection; refraction += o.refraction;
         aov_probe += o.aov_probe;
+        shadow_skipped_unreached += o.shadow_skipped_unreached;
+        shadow_skipped_facing += o.shadow_skipped_facing;
+        secondary_skipped_cutoff += o.secondary_skipped_cutoff;
         return *this;
     }
 };
@@ -43,8 +79,8 @@ struct PrimaryInfo {
 
 class WhittedIntegrator {
 public:
-    WhittedIntegrator(const SceneView& view, const Accelerator& accel, const IntegratorSettings& settings)
-        : m_view(view), m_accel(accel), m_settings(settings) {}
+    /// Selects the kernel for the view's scene (select_kernel) once.
+    WhittedIntegrator(const SceneView& view, const Accelerator& accel, const IntegratorSettings& settings);
 
     /// Radiance arriving along `ray` (a unit-direction ray of the given kind at tree depth
     /// `depth`). Never NaN or infinite. `primary` (optional) receives first-hit data. `cone` is the
@@ -52,20 +88,34 @@ public:
     /// `weight` is the path's accumulated kr/kt weight (1 for camera rays), compared with
     /// IntegratorSettings::min_weight before secondary rays are spawned.
     Color trace(const Ray& ray, RayKind kind, int depth, RayCounters& counters, PrimaryInfo* primary = nullptr,
-                const RayCone& cone = {}, float weight = 1.f) const;
+                const RayCone& cone = {}, float weight = 1.f) const {
+        return (this->*m_trace)(ray, kind, depth, counters, primary, cone, weight);
+    }
     /// First-hit data only (no shading, no secondary rays) for a camera ray: AOVs of pixel centres
     /// in anti-aliasing modes that trace no centre sample. Counted as `aov_probe`.
     void probe(const Ray& ray, RayCounters& counters, PrimaryInfo& primary) const;
 
     const IntegratorSettings& settings() const { return m_settings; }
+    /// The kernel selected for this scene and settings.
+    const KernelFeatures& kernel() const { return m_kernel; }
 
 private:
+    using TraceFn = Color (WhittedIntegrator::*)(const Ray&, RayKind, int, RayCounters&, PrimaryInfo*, const RayCone&,
+                                                 float) const;
+    template <KernelFeatures K>
+    Color trace_kernel(const Ray& ray, RayKind kind, int depth, RayCounters& counters, PrimaryInfo* primary,
+                       const RayCone& cone, float weight) const;
+    template <KernelFeatures K>
     Color shade(const Ray& ray, const Hit& hit, int depth, RayCounters& counters, PrimaryInfo* primary,
                 const RayCone& cone, float weight) const;
+    template <KernelFeatures K>
+    static TraceFn kernel_entry() { return &WhittedIntegrator::trace_kernel<K>; }
 
     const SceneView& m_view;
     const Accelerator& m_accel;
     IntegratorSettings m_settings;
+    KernelFeatures m_kernel;
+    TraceFn m_trace = nullptr;
 };
 
 }  // namespace whitted

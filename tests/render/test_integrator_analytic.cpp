@@ -297,3 +297,44 @@ TEST(IntegratorAnalytic, MinWeightCutsTheRayTreeWhereTheWeightFallsBelowIt) {
 
 }  // namespace
 }  // namespace whitted
+
+namespace whitted {
+namespace {
+
+// Lights that cannot reach a point cast no shadow ray: one beyond its glTF range, a spot whose
+// cone misses the floor and a light below the floor (N.L <= 0). Only the one light that reaches
+// the floor casts a shadow ray; the pixel is its diffuse term alone. Both kernels agree.
+TEST(IntegratorAnalytic, LightsThatCannotReachAPointCastNoShadowRay) {
+    Scene s;
+    add_floor(s, add_classic_material(s, diffuse(Color(0.5f))));
+    s.cameras.push_back(top_down_ortho(0.5));
+    Light far = point_light({0, 0, 4}, 100.f);
+    far.range = 3.f;  // 4 away: the window is exactly 0
+    s.lights.push_back(far);
+    Light spot;
+    spot.type = LightType::Spot;
+    spot.position = {0, 0, 2};
+    spot.direction = normalize(Vec3d(1, 0, 0.2));  // points away from the floor
+    spot.outer_cone = 0.3f;
+    spot.intensity = 100.f;
+    s.lights.push_back(spot);
+    s.lights.push_back(point_light({0, 0, -2}, 100.f));  // below the floor
+    s.lights.push_back(point_light({0, 0, 2}, 4.f));     // the one that counts: E = 4 / 2^2 = 1
+    for (const bool specialize : {false, true}) {
+        RenderSettings rs;
+        rs.width = rs.height = 1;
+        rs.threads = 1;
+        rs.integrator.ambient = Color(0.f);
+        rs.integrator.specialize = specialize;
+        Renderer renderer(s, rs);
+        RenderStats stats;
+        const Film film = renderer.render(&stats);
+        EXPECT_EQ(stats.rays.shadow, 1u);
+        EXPECT_EQ(stats.rays.shadow_skipped_unreached, 2u);  // range and cone
+        EXPECT_EQ(stats.rays.shadow_skipped_facing, 1u);     // below the surface
+        expect_color_near(film.beauty[0], Color(0.5f));
+    }
+}
+
+}  // namespace
+}  // namespace whitted

@@ -1,0 +1,199 @@
+// Stress 1 (issue #7): self-intersection at any scale, and 7: hit-point error against the double
+// reference. Bounded for CI; `whitted bench stability` runs the same probes with more points.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <string>
+
+#include "renderer/core/ray_offset.h"
+#include "tests/stress/stability_probes.h"
+
+namespace whitted::stress {
+namespace {
+
+const double kScales[] = {1e-4, 1e-2, 1.0, 1e2, 1e4, 1e6};
+const double kTranslations[] = {0.0, 1e3, 1e5};
+
+/// The object spans at least 16 float steps at its position: below that its world-space float
+/// image collapses (a 1e-4 object at 1e3, a 1e-2 object at 1e5) and its facets, normals and
+/// neighbours cannot be told apart in float; those cases only have to avoid self-hits.
+bool resolvable(double s, double t) { return s >= 16.0 * double(ulp(float(t + s))); }
+
+std::string label(const SelfIntersectionConfig& c) {
+    const char* surface = c.surface == ProbeSurface::AnalyticSphere ? "analytic sphere"
+                          : c.surface == ProbeSurface::TiltedQuad   ? "tilted quad"
+                          : c.smooth_normals                         ? "mesh (smooth normals)"
+                                                                     : "mesh (flat)";
+    return c.accel + " " + surface + " s=" + std::to_string(c.scale) + " t=" + std::to_string(c.translation);
+}
+
+/// The offset before issue #7 (Wächter & Binder 2019 as published: 256 ulps of each coordinate,
+/// 1/65536 absolute below 1/32), kept here to show the suite catches what it got wrong.
+Vec3f wachter_binder_2019(const Vec3f& p, const Vec3f& n) {
+    Vec3f o;
+    for (int k = 0; k < 3; ++k) {
+        const int32_t of = int32_t(256.f * n[k]);
+        const float pi = std::bit_cast<float>(std::bit_cast<int32_t>(p[k]) + (p[k] < 0.f ? -of : of));
+        o[k] = std::fabs(p[k]) < 1.f / 32.f ? p[k] + n[k] / 65536.f : pi;
+    }
+    return o;
+}
+
+// The offset kernel itself: at least kOffsetUlps ulp(max|p|) along n (rounded away from the
+// surface), at most kOffsetUlps + 2 (rounding of each component), the same relative amount at every
+// magnitude, never a denormal step (flush-to-zero would cancel it), and the sign of n respected
+// component by component.
+TEST(StressOffset, KernelScalesWithMagnitude) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-1.f, 1.f), e(-40.f, 40.f);
+    for (int i = 0; i < 20000; ++i) {
+        const float mag = std::exp2(e(rng));
+        const Vec3f p = Vec3f(u(rng), u(rng), u(rng)) * mag;
+        const Vec3f n = normalize(Vec3f(u(rng), u(rng), u(rng)));
+        if (n == Vec3f(0.f)) continue;
+        const Vec3f o = offset_ray_origin(p, n);
+        const double step = std::max(double(ulp(max_abs(p))), double(std::numeric_limits<float>::min()));
+        const double along = dot(Vec3d(o) - Vec3d(p), Vec3d(n)) / step;
+        EXPECT_GE(along, 4.0) << i;
+        EXPECT_LE(along, 4.0 + 3.0 * std::sqrt(3.0)) << i;  // one step per component, maybe in the next binade
+        for (int k = 0; k < 3; ++k) {
+            if (n[k] > 0.f) {
+                EXPECT_GT(o[k], p[k]);
+            } else if (n[k] < 0.f) {
+                EXPECT_LT(o[k], p[k]);
+            }
+            EXPECT_TRUE(o[k] == 0.f || std::fabs(o[k]) >= std::numeric_limits<float>::min());
+        }
+    }
+    // At the origin: FLT_MIN steps, which survive flush-to-zero.
+    const Vec3f o = offset_ray_origin(Vec3f(0.f), Vec3f(0, 0, 1));
+    EXPECT_GE(o.z, 4.f * std::numeric_limits<float>::min());
+}
+
+// Random points of a closed tessellated sphere and of an analytic sphere, scaled 1e-4 .. 1e6 and
+// translated up to 1e5 (rotated, transforms in double); reflection, refraction and shadow rays
+// over the hemisphere (half uniform, half grazing down to cos 1e-4) leave each point exactly as
+// the integrator spawns them. None may hit its own surface, and neighbour surfaces
+// kGuaranteedGapUlps ulp(max|p|) in front (outside and inside) must be hit.
+TEST(StressSelfIntersection, NoSelfHitsAndNeighboursHitAtAnyScale) {
+    for (const char* accel : {"bvh", "embree"})
+        for (int surface = 0; surface < 3; ++surface)
+            for (double t : kTranslations)
+                for (double s : kScales) {
+                    SelfIntersectionConfig c;
+                    c.accel = accel;
+                    c.surface = surface == 2 ? ProbeSurface::AnalyticSphere : ProbeSurface::MeshSphere;
+                    c.smooth_normals = surface == 1;
+                    c.scale = s;
+                    c.translation = t;
+                    c.points = 300;
+                    c.directions = 6;
+                    c.gap_ulps = kGuaranteedGapUlps;
+                    c.seed = uint64_t(7 + surface);
+                    const SelfIntersectionResult r = probe_self_intersection(c);
+                    const std::string what = label(c);
+                    for (int k = 0; k < 3; ++k) EXPECT_EQ(r.self_hits[k], 0u) << what << " kind " << k;
+                    if (!resolvable(s, t)) continue;
+                    EXPECT_GT(r.points, c.points * 9 / 10) << what;
+                    EXPECT_GT(r.min_offset_ulps, 0.0) << what;
+                    EXPECT_LE(r.max_offset_ulps, double(kGuaranteedGapUlps)) << what;
+                    EXPECT_EQ(r.neighbour_misses[0], 0u) << what << " reflection";
+                    EXPECT_EQ(r.neighbour_misses[1], 0u) << what << " refraction";
+                    // Smooth normals lift shadow origins onto the smooth surface (Hanika 2021): up
+                    // to the tessellation's sag above the facet, beyond a neighbour ulps away.
+                    if (!c.smooth_normals) {
+                        EXPECT_EQ(r.neighbour_misses[2], 0u) << what << " shadow";
+                    }
+                }
+}
+
+// The same probe with the pre-#7 offset: neighbours within its 256-ulp (and, below |p| = 1/32,
+// 1/65536 absolute) offset are skipped, so the test above can fail.
+TEST(StressSelfIntersection, PreviousOffsetSkipsNeighbours) {
+    for (double s : {1e-4, 1.0}) {
+        SelfIntersectionConfig c;
+        c.scale = s;
+        c.points = 200;
+        c.directions = 4;
+        c.gap_ulps = kGuaranteedGapUlps;
+        c.offset = wachter_binder_2019;
+        const SelfIntersectionResult r = probe_self_intersection(c);
+        const uint64_t rays = r.rays[0] + r.rays[1] + r.rays[2];
+        const uint64_t misses = r.neighbour_misses[0] + r.neighbour_misses[1] + r.neighbour_misses[2];
+        EXPECT_GT(misses, rays / 2) << "s=" << s;
+        if (s == 1e-4) {
+            EXPECT_GT(r.max_offset_ulps, 1e6);  // 1/65536 is ~2e6 ulps of 1e-4
+        }
+    }
+}
+
+// A large tilted square through the world origin, points down to 1e-4 of its size from the
+// origin: SceneView interpolates the hit point from float world-space vertices far larger than the
+// point, so its error is thousands of ulp(max|p|) (cancellation) and no offset relative to |p|
+// covers it. With the hit point computed in double (the proposed SceneView change, emulated
+// here) the same offset has no self-hits at any scale.
+TEST(StressSelfIntersection, TiltedQuadThroughOriginWithDoubleHitPoint) {
+    for (const char* accel : {"bvh", "embree"})
+        for (double s : kScales) {
+            SelfIntersectionConfig c;
+            c.accel = accel;
+            c.surface = ProbeSurface::TiltedQuad;
+            c.scale = s;
+            c.points = 300;
+            c.directions = 6;
+            c.exact_point = true;
+            const SelfIntersectionResult r = probe_self_intersection(c);
+            for (int k = 0; k < 3; ++k) EXPECT_EQ(r.self_hits[k], 0u) << label(c) << " kind " << k;
+        }
+}
+
+// Known problem, not fixed here (renderer/integrator/scene_view.cpp, see the report in
+// docs/numerical-stability.md): with today's float hit point the tilted square self-intersects.
+// The bound documents the current state; when SceneView computes p in double this falls to 0
+// and the bound should become EXPECT_EQ(self, 0).
+TEST(StressSelfIntersection, TiltedQuadThroughOriginCurrentHitPointIsBounded) {
+    SelfIntersectionConfig c;
+    c.surface = ProbeSurface::TiltedQuad;
+    c.scale = 1.0;
+    c.points = 300;
+    c.directions = 6;
+    const SelfIntersectionResult r = probe_self_intersection(c);
+    const uint64_t rays = r.rays[0] + r.rays[1] + r.rays[2];
+    const uint64_t self = r.self_hits[0] + r.self_hits[1] + r.self_hits[2];
+    RecordProperty("self_hit_fraction", std::to_string(double(self) / double(rays)));
+    EXPECT_LE(self, rays * 35 / 100);
+    std::vector<double> e = r.point_error_ulps;
+    const Distribution d = distribution(e);
+    EXPECT_GT(d.max, 100.0);  // the cancellation the double hit point removes
+}
+
+// Stress 7: the integrator's float hit point (SceneView, after the Embree or in-house float hit)
+// against the exact point of the double-precision reference; error in ulp(max|p|).
+TEST(StressHitError, FloatHitPointsWithinFewUlps) {
+    for (const char* accel : {"bvh", "embree"})
+        for (bool sphere : {false, true})
+            for (double t : kTranslations)
+                for (double s : kScales) {
+                    if (!resolvable(s, t)) continue;
+                    HitErrorResult r = probe_hit_error(accel, sphere, s, t, 1000, 3);
+                    const std::string what = std::string(accel) + (sphere ? " sphere" : " mesh") +
+                                             " s=" + std::to_string(s) + " t=" + std::to_string(t);
+                    EXPECT_GT(r.both_hit, 500u) << what;
+                    EXPECT_LE(r.miss_mismatch, r.rays / 100) << what;  // grazing rays at the silhouette
+                    const Distribution d = distribution(r.ulp_error);
+                    // Measured (docs/numerical-stability.md): median <= 1.9, max <= 20 ulps for
+                    // triangles (float barycentrics move the point along the surface), max <= 10
+                    // for spheres (t error along the ray before the re-projection).
+                    EXPECT_LE(d.median, 2.5) << what;
+                    EXPECT_LE(d.max, sphere ? 16.0 : 32.0) << what;
+                    std::vector<double> rel = r.rel_error;
+                    EXPECT_LE(distribution(rel).max, 3e-6) << what;
+                }
+}
+
+}  // namespace
+}  // namespace whitted::stress
