@@ -112,8 +112,8 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
         throw Error(fmt::format("--camera {}: the scene has {} camera(s), valid indices are 0..{}", settings.camera,
                                 scene.cameras.size(), scene.cameras.size() - 1));
     if (settings.tile_size < 1) throw Error(fmt::format("tile size must be at least 1 (got {})", settings.tile_size));
-    if (settings.integrator.max_depth < 0)
-        throw Error(fmt::format("--max-depth must be >= 0 (got {})", settings.integrator.max_depth));
+    if (settings.integrator.max_depth < 0 || settings.integrator.max_depth > kMaxTreeDepth)
+        throw Error(fmt::format("--max-depth must be in 0..{} (got {})", kMaxTreeDepth, settings.integrator.max_depth));
     m_size = resolve_image_size(scene.cameras[size_t(settings.camera)], settings.width, settings.height);
     constexpr int kMaxDim = 1 << 15;
     if (m_size.width > kMaxDim || m_size.height > kMaxDim)
@@ -373,7 +373,8 @@ Film Renderer::render(const AaSettings& aa, RenderStats* stats) const {
 Film Renderer::render(const AaSettings& aa, const IntegratorSettings& settings, const Accelerator& accel,
                       RenderStats* stats) const {
     validate_aa_settings(aa);
-    if (settings.max_depth < 0) throw Error(fmt::format("--max-depth must be >= 0 (got {})", settings.max_depth));
+    if (settings.max_depth < 0 || settings.max_depth > kMaxTreeDepth)
+        throw Error(fmt::format("--max-depth must be in 0..{} (got {})", kMaxTreeDepth, settings.max_depth));
     const Camera& cam = m_scene.cameras[size_t(m_settings.camera)];
     const CameraModel camera(cam, m_size.width, m_size.height);
     const WhittedIntegrator integrator(m_view, accel, settings);
@@ -449,6 +450,12 @@ Film Renderer::render(const AaSettings& aa, const IntegratorSettings& settings, 
         stats->threads = threads;
     }
     if (frame.nonfinite() > 0) log_warning("{} samples were not finite and were set to 0", frame.nonfinite());
+    // Last line of defence: no NaN or infinity ever reaches an output file (the samples above are
+    // already sanitized; this catches AOVs and anything a future stage might introduce).
+    if (const size_t bad = film.sanitize_nonfinite(); bad > 0) {
+        log_warning("{} film values were not finite and were set to 0", bad);
+        if (stats) stats->nonfinite_samples += bad;
+    }
     return film;
 }
 

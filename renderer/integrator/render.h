@@ -18,6 +18,10 @@
 
 namespace whitted {
 
+/// Deepest ray tree a render accepts: the recursion uses the stack (about 1 KB per level), and
+/// 1024 levels stay far inside an 8 MB thread stack (depth 30000 overflowed it).
+constexpr int kMaxTreeDepth = 1024;
+
 struct RenderSettings {
     int width = 0, height = 0;            ///< pixels; 0 = from the camera's aspect ratio (default 640 wide)
     int camera = 0;                       ///< index into Scene::cameras

@@ -121,28 +121,37 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
     const float u = hit.u, v = hit.v, w = 1.f - hit.u - hit.v;
     sp.material = mesh.material;
 
-    // Position from the world-space vertices (not o + t d): accurate enough for ulp offsets.
-    const Vec3f p0 = xf_point(xf.m, mesh.positions[i0]);
-    const Vec3f p1 = xf_point(xf.m, mesh.positions[i1]);
-    const Vec3f p2 = xf_point(xf.m, mesh.positions[i2]);
-    sp.p = p0 * w + p1 * u + p2 * v;
+    // Position from the world-space vertices (not o + t d), transformed and blended in double
+    // with one final rounding: interpolating float world vertices much larger than the point (a
+    // big triangle passing near the origin) cancels catastrophically and leaves the point
+    // thousands of ulps off the surface, beyond any ulp-scaled ray offset
+    // (docs/numerical-stability.md, StressSelfIntersection.TiltedQuadThroughOrigin*).
+    const Mat4d& world = m_scene.instances[hit.inst].world_from_object;
+    const Vec3d w0 = world.apply_point(Vec3d(mesh.positions[i0]));
+    const Vec3d w1 = world.apply_point(Vec3d(mesh.positions[i1]));
+    const Vec3d w2 = world.apply_point(Vec3d(mesh.positions[i2]));
+    const double ud = u, vd = v, wd = 1.0 - ud - vd;
+    sp.p = Vec3f(w0 * wd + w1 * ud + w2 * vd);
     sp.p_shadow = sp.p;
+    const Vec3f p0(w0), p1(w1), p2(w2);
     if (!mesh.normals.empty()) {
         // Shadow terminator (Hanika, "Hacking the Shadow Terminator", Ray Tracing Gems II, 2021):
         // with smooth normals on a coarse mesh, points near the terminator see the light by N.L but
         // the flat triangle is shadowed by its neighbours, giving blocky shadows. Lift the shadow
         // origin onto the tangent planes of the vertex normals, blended barycentrically. Done in
         // object space, where the planes are exact, then transformed (affine maps keep planes).
-        const Vec3f& a = mesh.positions[i0];
-        const Vec3f& b = mesh.positions[i1];
-        const Vec3f& c = mesh.positions[i2];
-        const Vec3f po = a * w + b * u + c * v;
-        auto lift = [&](const Vec3f& pv, const Vec3f& nv) { return nv * std::min(0.f, dot(po - pv, nv)); };
-        const Vec3f delta = lift(a, mesh.normals[i0]) * w + lift(b, mesh.normals[i1]) * u + lift(c, mesh.normals[i2]) * v;
-        if (delta != Vec3f(0.f) && is_finite(delta)) sp.p_shadow = xf_point(xf.m, po - delta);
+        const Vec3d a(mesh.positions[i0]), b(mesh.positions[i1]), c(mesh.positions[i2]);
+        const Vec3d po = a * wd + b * ud + c * vd;
+        auto lift = [&](const Vec3d& pv, const Vec3f& nv) {
+            const Vec3d n(nv);
+            return n * std::min(0.0, dot(po - pv, n));
+        };
+        const Vec3d delta = lift(a, mesh.normals[i0]) * wd + lift(b, mesh.normals[i1]) * ud + lift(c, mesh.normals[i2]) * vd;
+        if (delta != Vec3d(0.0) && std::isfinite(delta.x) && std::isfinite(delta.y) && std::isfinite(delta.z))
+            sp.p_shadow = Vec3f(world.apply_point(po - delta));
     }
-    Vec3f ng = normalize(cross(p1 - p0, p2 - p0));
-    if (ng == Vec3f(0.f)) ng = normalize(-ray.dir);  // degenerate triangle: face the ray
+    Vec3f ng = Vec3f(normalize(cross(w1 - w0, w2 - w0)));  // in double: no cancellation far from the origin
+    if (!(ng != Vec3f(0.f)) || !is_finite(ng)) ng = normalize(-ray.dir);  // degenerate triangle: face the ray
     sp.ng = ng;
 
     // Texture and vertex-color inputs: skipped when nothing in the scene varies over a surface.

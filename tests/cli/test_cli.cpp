@@ -225,7 +225,11 @@ TEST(Cli, InterruptedRenderLeavesNoFile) {
                 "--no-progress", "-o", out.c_str(), static_cast<char*>(nullptr));
         ::_exit(127);
     }
-    ::usleep(1500 * 1000);  // loaded and rendering (the render takes minutes)
+    // Wait until the scene is loaded and the render has begun (the log line before rendering names
+    // the camera; under load, start-up alone can take seconds), then interrupt.
+    for (int i = 0; i < 400 && slurp(err).find("camera") == std::string::npos; ++i) ::usleep(50 * 1000);
+    ASSERT_NE(slurp(err).find("camera"), std::string::npos) << slurp(err);
+    ::usleep(300 * 1000);
     ASSERT_EQ(::kill(pid, SIGINT), 0);
     int status = 0;
     pid_t done = 0;

@@ -90,12 +90,16 @@ TEST(StressDeepTree, MinWeightCutsTheTree) {
 // RenderSettings accepts any value and a library caller asking for 30000 levels overflows the
 // stack (measured: 10000 levels render, 30000 crash, on the main thread and on TBB workers).
 // Proposed: Renderer's constructor rejects max_depth above a documented cap (e.g. 1024).
-TEST(StressDeepTree, DISABLED_RendererRejectsDepthBeyondTheStack) {
+TEST(StressDeepTree, RendererRejectsDepthBeyondTheStack) {
     RenderSettings rs;
     rs.width = rs.height = 1;
     rs.integrator.max_depth = 1 << 20;
     const Scene s = mirrors(1.0, 0.9f, true);
     EXPECT_THROW(Renderer(s, rs), Error);
+    rs.integrator.max_depth = kMaxTreeDepth + 1;
+    EXPECT_THROW(Renderer(s, rs), Error);
+    rs.integrator.max_depth = kMaxTreeDepth;  // the deepest accepted tree renders
+    EXPECT_NO_THROW(Renderer(s, rs).render());
 }
 
 }  // namespace
