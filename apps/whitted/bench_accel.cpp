@@ -11,11 +11,16 @@
 // `bvh` on a few thousand rays. Each cell has a time budget; cells expected to exceed it are
 // skipped and listed. Writes CSV and, when python3-matplotlib is installed, a log-log PNG via
 // scripts/plot_accel.py.
+//
+// `--ratio` instead compares the backends on one thread, interleaved (run_ratio): time per ray
+// and its ratio to the first backend (Embree), the median over `--repeats` rounds.
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -50,6 +55,8 @@ struct BenchAccelOptions {
     std::string out = "out/bench_accel";
     std::string precision = "float";
     std::string bv = "aabb";
+    bool ratio = false;             ///< --ratio: interleaved one-thread timing, ratios to the first backend
+    int repeats = 5;                ///< --ratio: interleaved repetitions (the median is reported)
 };
 
 class OpaqueFilter final : public SurfaceFilter {
@@ -211,7 +218,132 @@ double throughput(const Accelerator& accel, const std::vector<Ray>& rays, bool s
     return double(count) / best * 1e-6;
 }
 
-int run(const BenchAccelOptions& o) {
+// ---- --ratio: one thread, backends interleaved, time per ray relative to the first ----
+
+/// CPU time of the calling thread: time the thread was descheduled (other processes on a
+/// loaded machine) does not count.
+double thread_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+/// Nanoseconds per ray of one pass over `rays` on the calling thread (no task scheduler): the
+/// fastest of at least `min_passes` passes and of as many as fit in about 0.15 s of thread CPU
+/// time. The minimum is the figure least disturbed by other processes (they only add time).
+double ns_per_ray(const Accelerator& accel, const std::vector<Ray>& rays, bool shadow, int min_passes) {
+    if (rays.empty()) return 0.0;
+    double best = 1e30, total = 0.0;
+    for (int p = 0; p < 1000 && (p < min_passes || total < 0.15); ++p) {
+        volatile float sink = 0.f;
+        const double t = thread_seconds();
+        if (shadow)
+            for (const Ray& r : rays) sink = sink + accel.transmittance(r).x;
+        else
+            for (const Ray& r : rays) sink = sink + accel.intersect(r, RayKind::Camera).t;
+        const double dt = thread_seconds() - t;
+        best = std::min(best, dt);
+        total += dt;
+    }
+    return best * 1e9 / double(rays.size());
+}
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
+}
+
+std::string load_average() {
+    std::ifstream in("/proc/loadavg");
+    std::string a, b, c;
+    in >> a >> b >> c;
+    return a.empty() ? "unknown" : a + " " + b + " " + c;
+}
+
+/// For each scene and size: builds every backend, validates it, then `repeats` times measures
+/// every ray kind on one thread for each backend in turn (so all backends see the same machine
+/// load), and reports the median time per ray and the median of the per-repetition ratios to the
+/// first backend (Embree by default).
+int run_ratio(const BenchAccelOptions& o) {
+    namespace fs = std::filesystem;
+    fs::create_directories(o.out);
+    const std::string csv_path = (fs::path(o.out) / "ratio.csv").string();
+    std::ofstream csv(csv_path);
+    csv << "scene,triangles,accel,kind,ns_per_ray_median,ratio_median,ratio_min,ratio_max,repeats,load_before,load_after,"
+           "validated_against,mismatch_fraction\n";
+    OpaqueFilter filter;
+    const char* kinds[3] = {"camera", "shadow", "incoherent"};
+    for (const std::string& kind : o.scenes) {
+        for (long n : o.sizes) {
+            const Scene scene = make_scene(kind, n);
+            const size_t tris = scene.instanced_triangle_count();
+            const auto reference = create_accelerator("bvh:width=2", scene, filter);
+            const RaySets rays = make_rays(*reference, o.rays);
+            std::unique_ptr<Accelerator> brute;
+            if (tris <= 100000) brute = create_accelerator("brute", scene, filter);
+            const Accelerator& oracle = brute ? *brute : *reference;
+            std::vector<std::unique_ptr<Accelerator>> accels;
+            std::vector<double> mismatch;
+            for (const std::string& name : o.accels) {
+                accels.push_back(create_accelerator(name, scene, filter));
+                mismatch.push_back(validate(*accels.back(), oracle, rays, 1500));
+            }
+            const std::vector<Ray>* sets[3] = {&rays.camera, &rays.shadow, &rays.incoherent};
+            // ns[accel][kind][repeat]
+            std::vector<std::array<std::vector<double>, 3>> ns(accels.size());
+            const std::string load_before = load_average();
+            for (int rep = 0; rep < o.repeats; ++rep)
+                for (int k = 0; k < 3; ++k)
+                    for (size_t a = 0; a < accels.size(); ++a)
+                        ns[a][k].push_back(ns_per_ray(*accels[a], *sets[k], k == 1, 3));
+            const std::string load_after = load_average();
+            std::printf("\n%s, %zu triangles, %zu/%zu/%zu rays, 1 thread, %d interleaved repeats, load %s -> %s\n",
+                        kind.c_str(), tris, rays.camera.size(), rays.shadow.size(), rays.incoherent.size(), o.repeats,
+                        load_before.c_str(), load_after.c_str());
+            std::printf("  %-22s %10s %10s %10s   %-26s %-26s %-26s %s\n", "accel", "cam ns", "shd ns", "inc ns",
+                        "cam ratio [min,max]", "shd ratio [min,max]", "inc ratio [min,max]", "validation");
+            for (size_t a = 0; a < accels.size(); ++a) {
+                std::string cells[3];
+                double med[3];
+                for (int k = 0; k < 3; ++k) {
+                    std::vector<double> ratios;
+                    for (int rep = 0; rep < o.repeats; ++rep) ratios.push_back(ns[a][k][size_t(rep)] / ns[0][k][size_t(rep)]);
+                    med[k] = median(ns[a][k]);
+                    const double r = median(ratios);
+                    const auto [lo, hi] = std::minmax_element(ratios.begin(), ratios.end());
+                    cells[k] = fmt::format("{:.2f}x [{:.2f},{:.2f}]", r, *lo, *hi);
+                    csv << fmt::format("{},{},{},{},{:.2f},{:.4f},{:.4f},{:.4f},{},{},{},{},{:.6f}\n", kind, tris,
+                                       o.accels[a], kinds[k], med[k], r, *lo, *hi, o.repeats, load_before, load_after,
+                                       brute ? "brute" : "bvh:width=2", mismatch[a]);
+                }
+                std::printf("  %-22s %10.1f %10.1f %10.1f   %-26s %-26s %-26s %s\n", o.accels[a].c_str(), med[0], med[1],
+                            med[2], cells[0].c_str(), cells[1].c_str(), cells[2].c_str(),
+                            mismatch[a] <= 1e-3 ? fmt::format("ok ({:.4f}%)", 100 * mismatch[a]).c_str()
+                                                : fmt::format("UNTRUSTED ({:.3f}%)", 100 * mismatch[a]).c_str());
+                std::fflush(stdout);
+            }
+        }
+    }
+    std::printf("wrote %s\n", csv_path.c_str());
+    return 0;
+}
+
+/// --accel is split at commas, which also separate a spec's options: a piece "key=value" without
+/// a backend name continues the spec before it ("bvh:leaf=16", "bins=32" -> "bvh:leaf=16,bins=32").
+std::vector<std::string> join_spec_options(const std::vector<std::string>& pieces) {
+    std::vector<std::string> specs;
+    for (const std::string& p : pieces) {
+        const bool option = p.find('=') != std::string::npos && p.find(':') == std::string::npos;
+        if (option && !specs.empty()) specs.back() += "," + p;
+        else specs.push_back(p);
+    }
+    return specs;
+}
+
+int run(BenchAccelOptions o) {
+    o.accels = join_spec_options(o.accels);
+    if (o.ratio) return run_ratio(o);
     namespace fs = std::filesystem;
     fs::create_directories(o.out);
     const std::string csv_path = (fs::path(o.out) / "accel.csv").string();
@@ -294,7 +426,7 @@ int run(const BenchAccelOptions& o) {
 Command register_bench_accel(CLI::App& bench) {
     auto o = std::make_shared<BenchAccelOptions>();
     CLI::App* app = bench.add_subcommand("accel", "Accelerators: build time, memory, Mrays/s (docs/accelerators.md)");
-    app->add_option("--accel", o->accels, "Backends to measure (names or specs like grid:lambda=8)")->delimiter(',')
+    app->add_option("--accel", o->accels, "Backends to measure (names or specs like grid:lambda=8 or bvh:width=2,leaf=4)")->delimiter(',')
         ->capture_default_str();
     app->add_option("--scenes", o->scenes, "Procedural scenes: spheres, soup, terrain")->delimiter(',')->capture_default_str();
     app->add_option("--sizes", o->sizes, "Triangle counts")->delimiter(',')->capture_default_str();
@@ -308,6 +440,11 @@ Command register_bench_accel(CLI::App& bench) {
     app->add_option("--bv", o->bv, "Bounding volume of the in-house bvh nodes: aabb or sphere")
         ->check(CLI::IsMember({"aabb", "sphere"}))->capture_default_str();
     app->add_option("-o,--out", o->out, "Output directory for accel.csv and accel.png")->capture_default_str();
+    app->add_flag("--ratio", o->ratio,
+                  "One thread, backends interleaved: time per ray and its ratio to the first --accel "
+                  "(writes ratio.csv)");
+    app->add_option("--repeats", o->repeats, "Interleaved repetitions for --ratio (median reported)")
+        ->check(CLI::Range(1, 100))->capture_default_str();
     return {app, [o] { return run(*o); }};
 }
 

@@ -66,6 +66,7 @@ public:
         number("leaf", b.max_leaf_size, 1, 256);
         number("traversal_cost", b.traversal_cost, 0, 1e6);
         number("intersection_cost", b.intersection_cost, 1e-6, 1e6);
+        number("block", b.leaf_block, 1, 64);
     }
     /// Throws for options no backend setting consumed.
     void check_all_used(const char* valid) const {
@@ -104,19 +105,35 @@ std::unique_ptr<Accelerator> create_backend(const std::string& name, const Scene
     if (spec.name() == "bvh") {
         BvhConfig c;
         spec.precision(c.precision);
-        spec.build(c.build);
         if (const std::string* bv = spec.find("bv")) {
             if (*bv == "aabb") c.volume = BoundingVolume::Aabb;
             else if (*bv == "sphere") c.volume = BoundingVolume::Sphere;
             else throw Error(fmt::format("accelerator '{}': bv must be aabb or sphere", name));
         }
-        spec.check_all_used("precision, bv, bins, leaf, traversal_cost, intersection_cost");
+        if (const std::string* w = spec.find("width")) {
+            if (*w == "2" || *w == "4" || *w == "8") c.width = std::stoi(*w);
+            else throw Error(fmt::format("accelerator '{}': width must be 2, 4 or 8", name));
+            if (c.width != 2 && (c.precision == Precision::Double || c.volume == BoundingVolume::Sphere))
+                throw Error(fmt::format("accelerator '{}': width {} needs precision=float and bv=aabb (the double "
+                                        "and sphere BVHs are binary)", name, c.width));
+        } else if (c.precision == Precision::Double || c.volume == BoundingVolume::Sphere) {
+            c.width = 2;
+        }
+        // Wide trees test leaf triangles four at a time: the SAH counts them in blocks of four.
+        if (c.width != 2) c.build = wide_bvh_build_defaults();
+        spec.build(c.build);
+        if (const std::string* isa = spec.find("isa")) {
+            if (*isa == "auto") c.allow_avx2 = true;
+            else if (*isa == "sse2") c.allow_avx2 = false;
+            else throw Error(fmt::format("accelerator '{}': isa must be auto or sse2", name));
+        }
+        spec.check_all_used("precision, bv, width, isa, bins, leaf, traversal_cost, intersection_cost, block");
         return create_bvh_accelerator(scene, filter, c);
     }
     if (spec.name() == "kdop") {
         KdopConfig c;
         spec.build(c.build);
-        spec.check_all_used("bins, leaf, traversal_cost, intersection_cost");
+        spec.check_all_used("bins, leaf, traversal_cost, intersection_cost, block");
         return create_kdop_accelerator(scene, filter, c);
     }
     if (spec.name() == "brute") {

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 
 #include "importers/scene_loader.h"
 #include "renderer/core/error.h"
@@ -27,13 +28,17 @@ using namespace whitted::test;
 constexpr float kRelTol = 1e-6f;
 
 const std::vector<std::string>& fast_backends() {
-    static const std::vector<std::string> names{"bvh", "bvh:bv=sphere", "kdop", "grid", "octree"};
+    // "bvh" is the wide BVH (wide_bvh.h: 8-wide with AVX2, else 4-wide); width=2 the binary tree.
+    static const std::vector<std::string> names{"bvh", "bvh:width=2", "bvh:width=4", "bvh:bv=sphere", "kdop", "grid",
+                                                "octree"};
     return names;
 }
 
 /// Other settings of the same backends, checked on the Duck only (to keep the suite fast).
 const std::vector<std::string>& variant_backends() {
-    static const std::vector<std::string> names{"bvh:bins=8,leaf=2", "grid:lambda=1", "octree:leaf=4,depth=6"};
+    static const std::vector<std::string> names{"bvh:bins=8,leaf=2", "bvh:width=8,isa=sse2",
+                                                "bvh:leaf=64,intersection_cost=0.1",
+                                                "grid:lambda=1", "octree:leaf=4,depth=6"};
     return names;
 }
 
@@ -550,6 +555,101 @@ TEST(AccelDegenerate, InvalidSpheresAndPlanes) {
     }
 }
 
+// ---- the wide BVH against the binary one it is collapsed from ----
+
+/// Bit patterns of a hit's floats, to assert exact equality (not within a tolerance).
+bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+/// The wide BVH's triangle test runs the watertight test's operations in the same order on four
+/// lanes, and its node test culls nothing the binary one keeps: every hit must be bit for bit the
+/// binary tree's (t, u, v), and where the primitive differs (a tie at a shared edge, found in
+/// another order) t must be the same float. The AVX2 and SSE2 traversals must agree entirely.
+void expect_wide_equals_binary(const Scene& s, const SurfaceFilter& filter, const std::vector<Ray>& rays,
+                               const char* label) {
+    const auto binary = create_accelerator("bvh:width=2", s, filter);
+    for (const char* name :
+         {"bvh", "bvh:width=8", "bvh:width=4", "bvh:width=8,isa=sse2", "bvh:leaf=64,intersection_cost=0.1"}) {
+        SCOPED_TRACE(std::string(label) + " / " + name);
+        const auto wide = create_accelerator(name, s, filter);
+        size_t ties = 0, bad = 0, bad_tr = 0;
+        for (const Ray& r : rays) {
+            const Hit a = wide->intersect(r, RayKind::Camera), b = binary->intersect(r, RayKind::Camera);
+            if (a.valid() != b.valid() || !same_bits(a.t, b.t)) {
+                ++bad;
+            } else if (a.valid() && (a.prim != b.prim || a.geom != b.geom || a.inst != b.inst)) {
+                ++ties;
+            } else if (a.valid() && (!same_bits(a.u, b.u) || !same_bits(a.v, b.v))) {
+                ++bad;
+            }
+            Ray seg = r;
+            seg.tfar = 1.f;
+            const Color ta = wide->transmittance(seg), tb = binary->transmittance(seg);
+            bad_tr += same_bits(ta.x, tb.x) && same_bits(ta.y, tb.y) && same_bits(ta.z, tb.z) ? 0 : 1;
+        }
+        std::printf("[ %s ] %-36s %zu rays: %zu not bit-identical, %zu ties, %zu transmittances differ\n", label, name,
+                    rays.size(), bad, ties, bad_tr);
+        EXPECT_EQ(bad, 0u);
+        EXPECT_EQ(bad_tr, 0u);
+    }
+    // Same tree, same order: the AVX2 (where the CPU has it) and SSE2 code paths give identical
+    // records.
+    const auto avx = create_accelerator("bvh:width=8", s, filter);
+    const auto sse = create_accelerator("bvh:width=8,isa=sse2", s, filter);
+    size_t differ = 0;
+    for (const Ray& r : rays) {
+        const Hit a = avx->intersect(r, RayKind::Camera), b = sse->intersect(r, RayKind::Camera);
+        differ += std::memcmp(&a, &b, sizeof a) == 0 ? 0 : 1;
+    }
+    EXPECT_EQ(differ, 0u) << label << ": isa=auto vs isa=sse2";
+}
+
+TEST(AccelWideBvh, BitIdenticalToBinaryTree) {
+    const Scene mixed = mixed_scene();
+    std::vector<Ray> rays = make_rays(mixed, 2000, 77);
+    expect_wide_equals_binary(mixed, PatternFilter{}, rays, "mixed");
+    ImportOptions io;
+    io.load_textures = false;
+    const Scene duck = load_scene(WHITTED_ASSETS_DIR "/gltf/Duck/glTF-Binary/Duck.glb", io);
+    expect_wide_equals_binary(duck, OpaqueFilter{}, make_rays(duck, 2000, 78), "Duck");
+}
+
+/// Leaves of every size (1 to 3 packets, padded lanes), a root that is a leaf, nodes with fewer
+/// children than lanes, and a degenerate tree (median splits of coincident centroids).
+TEST(AccelWideBvh, OddShapedTrees) {
+    OpaqueFilter filter;
+    for (uint32_t n : {1u, 2u, 3u, 5u, 8u, 9u, 13u, 40u}) {
+        Scene s;
+        add_mesh_instance(s, make_soup(n, 3 + n, 1.f, 0.6f));
+        const auto oracle = create_accelerator("brute", s, filter);
+        for (const char* name : {"bvh", "bvh:width=4", "bvh:leaf=12,intersection_cost=0.01", "bvh:leaf=1"}) {
+            const auto accel = create_accelerator(name, s, filter);
+            size_t differ = 0;
+            for (const Ray& r : make_rays(s, 300, n))
+                differ += compare_hits(accel->intersect(r, RayKind::Camera), oracle->intersect(r, RayKind::Camera),
+                                       kRelTol) == Agreement::Differ;
+            EXPECT_EQ(differ, 0u) << name << " over " << n << " triangles";
+        }
+    }
+    // Many different triangles with one centroid (the origin): no SAH plane exists, the builder
+    // falls back to object-median splits.
+    Scene s;
+    Mesh m = make_soup(3000, 5, 1.f, 0.5f);
+    for (uint32_t i = 0; i < 3000; ++i) {
+        const float w = 1.f + 1e-3f * float(i), h = 0.25f + 1e-4f * float(i);
+        m.positions.insert(m.positions.end(), {{-w, -h, 0.f}, {w, -h, 0.f}, {0.f, 2.f * h, 0.f}});
+        const uint32_t b = uint32_t(m.positions.size()) - 3;
+        m.indices.insert(m.indices.end(), {b, b + 1, b + 2});
+    }
+    add_mesh_instance(s, m);
+    const auto oracle = create_accelerator("brute", s, filter);
+    const auto accel = create_accelerator("bvh", s, filter);
+    size_t differ = 0;
+    for (const Ray& r : make_rays(s, 1000, 3))
+        differ += compare_hits(accel->intersect(r, RayKind::Camera), oracle->intersect(r, RayKind::Camera), kRelTol) ==
+                  Agreement::Differ;
+    EXPECT_EQ(differ, 0u);
+}
+
 TEST(AccelFactory, UnknownNamesAndOptionsAreOneLineErrors) {
     Scene s;
     OpaqueFilter f;
@@ -563,6 +663,13 @@ TEST(AccelFactory, UnknownNamesAndOptionsAreOneLineErrors) {
     EXPECT_THROW((void)create_accelerator("grid:lamda=4", s, f), Error);
     EXPECT_THROW((void)create_accelerator("bvh:bins", s, f), Error);
     EXPECT_NO_THROW((void)create_accelerator("bvh:precision=double,bv=sphere,bins=32,leaf=4", s, f));
+    EXPECT_THROW((void)create_accelerator("bvh:width=3", s, f), Error);
+    EXPECT_THROW((void)create_accelerator("bvh:precision=double,width=8", s, f), Error);
+    EXPECT_THROW((void)create_accelerator("bvh:bv=sphere,width=4", s, f), Error);
+    EXPECT_THROW((void)create_accelerator("bvh:isa=avx9", s, f), Error);
+    EXPECT_NO_THROW((void)create_accelerator("bvh:precision=double,width=2", s, f));
+    EXPECT_NO_THROW((void)create_accelerator("bvh:width=4,isa=sse2", s, f));
+    EXPECT_NO_THROW((void)create_accelerator("bvh:width=8,isa=sse2,block=1", s, f));
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "renderer/accel/bvh/wide_bvh.h"
 #include "renderer/accel/common/two_level.h"
 
 namespace whitted {
@@ -146,6 +147,19 @@ std::unique_ptr<Accelerator> make_bvh(const char* name, const Scene& scene, cons
         [&](SpherePrims<T>&& s) { return SphereBlas(std::move(s), sphere_build); }, true);
 }
 
+/// `bvh` with N-wide mesh BVHs (float boxes); spheres and the top level keep the binary tree.
+template <int N>
+std::unique_ptr<Accelerator> make_wide_bvh(const Scene& scene, const SurfaceFilter& filter, const BvhBuildConfig& build,
+                                           const WideBvhOptions& options) {
+    using Blas = WideTriangleBvh<N>;
+    using SphereBlas = PrimBvh<float, AabbVolume<float>, SpherePrims<float>>;
+    BvhBuildConfig sphere_build = build;
+    sphere_build.max_leaf_size = std::min(build.max_leaf_size, 2);
+    return std::make_unique<TwoLevelAccelerator<float, Blas, SphereBlas>>(
+        "bvh", scene, filter, [&](const Mesh& m) { return Blas(TrianglePrims<float>(m), build, options); },
+        [&](SpherePrims<float>&& s) { return SphereBlas(std::move(s), sphere_build); }, true);
+}
+
 template <typename T>
 std::unique_ptr<Accelerator> make_brute(const Scene& scene, const SurfaceFilter& filter) {
     using Blas = PrimList<T, TrianglePrims<T>>;
@@ -160,6 +174,13 @@ std::unique_ptr<Accelerator> make_brute(const Scene& scene, const SurfaceFilter&
 std::unique_ptr<Accelerator> create_bvh_accelerator(const Scene& scene, const SurfaceFilter& filter,
                                                     const BvhConfig& config) {
     const bool dbl = config.precision == Precision::Double;
+    if (!dbl && config.volume == BoundingVolume::Aabb && config.width != 2) {
+        const WideBvhOptions options{config.allow_avx2};
+        // Without AVX2 an 8-wide node test is two SSE halves: 4-wide trees are faster there.
+        const int width = config.width != 0 ? config.width : (config.allow_avx2 && simd::cpu_has_avx2() ? 8 : 4);
+        return width == 4 ? make_wide_bvh<4>(scene, filter, config.build, options)
+                          : make_wide_bvh<8>(scene, filter, config.build, options);
+    }
     if (config.volume == BoundingVolume::Sphere)
         return dbl ? make_bvh<double, SphereVolume<double>>("bvh", scene, filter, config.build)
                    : make_bvh<float, SphereVolume<float>>("bvh", scene, filter, config.build);

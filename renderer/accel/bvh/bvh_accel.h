@@ -26,7 +26,19 @@ struct BvhConfig {
     BvhBuildConfig build;                        ///< binned SAH settings (bvh_tree.h)
     BoundingVolume volume = BoundingVolume::Aabb;///< node test (`--bv aabb|sphere`)
     Precision precision = Precision::Float;      ///< `--precision float|double`
+    int width = 0;                               ///< children per node: 8 or 4 (wide_bvh.h, float boxes
+                                                 ///< only), 2 (the binary tree; always for double/sphere),
+                                                 ///< 0 = 8 where the CPU has AVX2, else 4
+    bool allow_avx2 = true;                      ///< `isa=sse2` false: 8-wide node tests in SSE halves
 };
+
+/// The binned SAH settings `bvh` uses for wide trees (width 4 or 8) unless options override them.
+inline BvhBuildConfig wide_bvh_build_defaults() {
+    BvhBuildConfig b;
+    b.leaf_block = 4;           // leaves are tested in packets of four triangles (wide_bvh.h)
+    b.intersection_cost = 2.f;  // a packet test costs about two binary node steps (measured)
+    return b;
+}
 
 /// Settings of the `kdop` backend: the same SAH topology, nodes bounded by 7-slab k-DOPs fitted
 /// to the triangles below them.
@@ -40,7 +52,9 @@ struct BruteForceConfig {
 };
 
 /// Two-level SAH BVH (BLAS per mesh, TLAS over instances, one more BVH over the spheres),
-/// watertight triangle test, stable sphere test (common/sphere.h).
+/// watertight triangle test, stable sphere test (common/sphere.h). With float boxes and width 4
+/// or 8 the mesh BVHs are wide (SIMD node tests, triangles four at a time: wide_bvh.h); the
+/// top level and the sphere BVH stay binary.
 std::unique_ptr<Accelerator> create_bvh_accelerator(const Scene& scene, const SurfaceFilter& filter,
                                                     const BvhConfig& config);
 /// Two-level BVH whose nodes are k-DOPs (Kay & Kajiya 1986), spheres likewise.

@@ -73,7 +73,7 @@ private:
     struct Split {
         int axis = -1;
         int bin = 0;
-        double cost = std::numeric_limits<double>::infinity();  ///< sum of area x count of both sides
+        double cost = std::numeric_limits<double>::infinity();  ///< sum of area x blocks of both sides
     };
 
     /// Best binned split plane over the three axes (a separate frame so the bins do not stay on
@@ -100,7 +100,7 @@ private:
             for (int b = m_bins - 1; b > 0; --b) {
                 acc.extend(bin_box[size_t(b)]);
                 n_right += bin_count[size_t(b)];
-                right_cost[size_t(b)] = double(half_area(acc)) * n_right;
+                right_cost[size_t(b)] = double(half_area(acc)) * sah_blocks(n_right, m_config.leaf_block);
             }
             acc = Bounds3<T>{};
             uint32_t n_left = 0;
@@ -108,7 +108,8 @@ private:
                 acc.extend(bin_box[size_t(b)]);
                 n_left += bin_count[size_t(b)];
                 if (n_left == 0 || n_left == count) continue;
-                const double cost = double(half_area(acc)) * n_left + right_cost[size_t(b) + 1];
+                const double cost =
+                    double(half_area(acc)) * sah_blocks(n_left, m_config.leaf_block) + right_cost[size_t(b) + 1];
                 if (cost < best.cost) best = {axis, b + 1, cost};
             }
         }
@@ -137,7 +138,7 @@ private:
 
         uint32_t mid = 0;
         const double area = std::max(double(half_area(nb.box)), std::numeric_limits<double>::min());
-        const double leaf_cost = double(m_config.intersection_cost) * count;
+        const double leaf_cost = double(m_config.intersection_cost) * sah_blocks(count, m_config.leaf_block);
         if (best_axis >= 0) {
             const double split_cost = m_config.traversal_cost + m_config.intersection_cost * best_cost / area;
             if (split_cost >= leaf_cost && count <= uint32_t(std::max(1, m_config.max_leaf_size)))
@@ -231,7 +232,8 @@ double sah_cost(const std::vector<BuildNode<T>>& nodes, const BvhBuildConfig& co
     double cost = 0.0;
     for (const BuildNode<T>& n : nodes) {
         const double ratio = double(half_area(n.box)) / root;
-        cost += ratio * (n.count == 0 ? double(config.traversal_cost) : double(config.intersection_cost) * n.count);
+        cost += ratio * (n.count == 0 ? double(config.traversal_cost)
+                                      : double(config.intersection_cost) * sah_blocks(n.count, config.leaf_block));
     }
     return cost;
 }

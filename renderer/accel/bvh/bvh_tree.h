@@ -21,7 +21,14 @@ struct BvhBuildConfig {
     float traversal_cost = 1.f;       ///< SAH cost of visiting a node, relative to ...
     float intersection_cost = 1.f;    ///< ... the cost of testing one primitive
     size_t parallel_threshold = 4096; ///< nodes with at least this many primitives build their children in parallel
+    int leaf_block = 1;               ///< the SAH counts a leaf's primitives in blocks of this many, rounded up
+                                      ///< (4 for the wide BVH, whose leaves test triangles four at a time)
 };
+
+/// Primitives counted in blocks of `block` (the intersection tests a leaf of n primitives costs).
+inline uint32_t sah_blocks(uint32_t n, int block) {
+    return block <= 1 ? n : (n + uint32_t(block) - 1) / uint32_t(block);
+}
 
 /// A node as the builder leaves it: box, children or primitive range. Inner nodes have
 /// count == 0 and their children at index, index + 1; leaves hold ids[index, index + count).

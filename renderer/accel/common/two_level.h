@@ -180,7 +180,9 @@ private:
             if (d.object_from_world.identity) return blas.traverse(org, dir, tnear, q);
             return blas.traverse(d.object_from_world.point(org), d.object_from_world.vector(dir), tnear, q);
         };
-        if (!m_bvh_top) {
+        // One instance (the common single-mesh scene): its BLAS tests its own root boxes, so the
+        // top level's set-up and box test would only add cost.
+        if (!m_bvh_top || m_instances.size() == 1) {
             for (const InstanceData& d : m_instances)
                 if (visit(d)) return;
             return;
