@@ -35,6 +35,7 @@
 #include "importers/image_decode.h"
 #include "importers/mesh_numbers.h"
 #include "importers/scene_defaults.h"
+#include "importers/scene_file_geometry.h"
 #include "importers/scene_loader.h"
 #include "importers/warning_log.h"
 #include "importers/located_error.h"
@@ -1040,22 +1041,6 @@ private:
                 mesh.tangents = generate_tangents(mesh, uv);
         }
         return mesh;
-    }
-
-    /// Area-weighted smooth vertex normals: the sum of the (unnormalized) face normals of every
-    /// triangle using the vertex, normalized; +Z where the sum vanishes.
-    static std::vector<Vec3f> smooth_normals(const Mesh& mesh) {
-        std::vector<Vec3f> acc(mesh.positions.size(), Vec3f(0.f));
-        for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-            const uint32_t a = mesh.indices[t], b = mesh.indices[t + 1], c = mesh.indices[t + 2];
-            const Vec3f fn = cross(mesh.positions[b] - mesh.positions[a], mesh.positions[c] - mesh.positions[a]);
-            acc[a] += fn, acc[b] += fn, acc[c] += fn;
-        }
-        for (Vec3f& n : acc) {
-            n = normalize(n);
-            if (!(length(n) > 0.5f)) n = {0.f, 0.f, 1.f};
-        }
-        return acc;
     }
 
     static Vec3f any_perpendicular(const Vec3f& n) {

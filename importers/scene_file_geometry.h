@@ -21,7 +21,9 @@ Mesh make_rectangle_mesh(const Vec3d& center, const Vec3d& normal, const Vec3d& 
 /// then z on ties) made perpendicular to it; unit length. `normal` must be unit.
 Vec3d default_u_axis(const Vec3d& normal);
 
-/// Area-weighted smooth vertex normals (+Z where they vanish), as the glTF importer generates.
+/// Area-weighted smooth vertex normals: the sum of the (unnormalized) face normals of every
+/// triangle using the vertex, normalized; +Z where the sum vanishes. Shared by the glTF importer
+/// (missing NORMAL) and scene-file meshes.
 std::vector<Vec3f> smooth_normals(const Mesh& mesh);
 
 /// Swaps two indices of every triangle (for transforms with a negative determinant).
