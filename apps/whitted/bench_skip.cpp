@@ -46,6 +46,7 @@
 
 #include "apps/whitted/command.h"
 #include "importers/scene_loader.h"
+#include "renderer/accel/embree/embree_ray.h"
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
 #include "renderer/integrator/render.h"
@@ -348,7 +349,7 @@ public:
             rtcInitIntersectContext(&ctx);
             for (size_t i = begin; i < end; ++i) {
                 RTCRay r;
-                set_ray(r, rays[i]);
+                set_rtc_ray(r, rays[i]);
                 rtcOccluded1(m_top, &ctx, &r);
             }
         });
@@ -371,26 +372,12 @@ private:
         }
         return double(rays.size()) / median(t) * 1e-6;
     }
-    static void set_ray(RTCRay& r, const Ray& ray) {
-        r.org_x = ray.org.x;
-        r.org_y = ray.org.y;
-        r.org_z = ray.org.z;
-        r.dir_x = ray.dir.x;
-        r.dir_y = ray.dir.y;
-        r.dir_z = ray.dir.z;
-        r.tnear = ray.tnear;
-        r.tfar = ray.tfar;
-        r.time = 0.f;
-        r.mask = 0xffffffffu;
-        r.id = 0;
-        r.flags = 0;
-    }
     void trace1(const Ray& ray) const {
         RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
         ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
         RTCRayHit rh;
-        set_ray(rh.ray, ray);
+        set_rtc_ray(rh.ray, ray);
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(m_top, &ctx, &rh);

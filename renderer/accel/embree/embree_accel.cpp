@@ -12,6 +12,7 @@
 
 #include "renderer/accel/common/geometry.h"
 #include "renderer/accel/common/primitives.h"
+#include "renderer/accel/embree/embree_ray.h"
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
 #include "renderer/scene/scene.h"
@@ -324,7 +325,7 @@ public:
         q.ray = &ray;
         q.kind = kind;
         RTCRayHit rh;
-        set_ray(rh.ray, ray);
+        set_rtc_ray(rh.ray, ray);
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(m_top, &q.rtc, &rh);
@@ -349,7 +350,7 @@ public:
         q.ray = &ray;
         q.kind = RayKind::Shadow;
         RTCRay r;
-        set_ray(r, ray);
+        set_rtc_ray(r, ray);
         rtcOccluded1(m_top, &q.rtc, &r);
         if (r.tfar == -kInfinity) return Color(0.f);  // an opaque surface blocked it
         return q.transmittance;
@@ -359,20 +360,6 @@ public:
     AccelStats stats() const override { return {m_build_seconds, m_bytes}; }
 
 private:
-    static void set_ray(RTCRay& r, const Ray& ray) {
-        r.org_x = ray.org.x;
-        r.org_y = ray.org.y;
-        r.org_z = ray.org.z;
-        r.dir_x = ray.dir.x;
-        r.dir_y = ray.dir.y;
-        r.dir_z = ray.dir.z;
-        r.tnear = ray.tnear;
-        r.tfar = ray.tfar;
-        r.time = 0.f;
-        r.mask = 0xffffffffu;
-        r.id = 0;
-        r.flags = 0;
-    }
 
     static void on_error(void* user, RTCError code, const char* message) {
         auto* self = static_cast<EmbreeAccelerator*>(user);
