@@ -1,6 +1,8 @@
 // The `whitted` program end to end: exit codes, one-line errors, outputs written.
 #include <gtest/gtest.h>
 
+#include "cli_util.h"
+
 #include <sys/wait.h>
 #include <unistd.h>
 #include <csignal>
@@ -14,35 +16,11 @@
 namespace {
 
 namespace fs = std::filesystem;
+using whitted::test::Result;
+using whitted::test::run;
+using whitted::test::slurp;
 
-struct Result {
-    int code = -1;
-    std::string out, err;
-};
 
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-/// Runs the whitted executable with `args` (shell-quoted by the caller).
-Result run(const std::string& args) {
-    static int counter = 0;
-    const fs::path dir = fs::temp_directory_path() / ("whitted_cli_" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    const fs::path out = dir / ("out" + std::to_string(counter) + ".txt");
-    const fs::path err = dir / ("err" + std::to_string(counter++) + ".txt");
-    const std::string cmd = std::string("'") + WHITTED_EXE + "' " + args + " >'" + out.string() + "' 2>'" +
-                            err.string() + "' </dev/null";
-    const int status = std::system(cmd.c_str());
-    Result r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-}
 
 size_t line_count(const std::string& s) {
     size_t n = 0;

@@ -2,6 +2,8 @@
 // end through the executable (the way tests/cli/test_cli.cpp runs it).
 #include <gtest/gtest.h>
 
+#include "cli_util.h"
+
 #include <OpenImageIO/imageio.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -16,18 +18,10 @@
 namespace {
 
 namespace fs = std::filesystem;
+using whitted::test::Result;
+using whitted::test::run;
+using whitted::test::slurp;
 
-struct Result {
-    int code = -1;
-    std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 fs::path temp_dir() {
     const fs::path dir = fs::temp_directory_path() / ("whitted_skip_cli_" + std::to_string(::getpid()));
@@ -35,20 +29,6 @@ fs::path temp_dir() {
     return dir;
 }
 
-/// Runs the whitted executable with `args` (shell-quoted by the caller).
-Result run(const std::string& args) {
-    static int counter = 0;
-    const fs::path out = temp_dir() / ("out" + std::to_string(counter) + ".txt");
-    const fs::path err = temp_dir() / ("err" + std::to_string(counter++) + ".txt");
-    const std::string cmd = std::string("'") + WHITTED_EXE + "' " + args + " >'" + out.string() + "' 2>'" +
-                            err.string() + "' </dev/null";
-    const int status = std::system(cmd.c_str());
-    Result r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-}
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
