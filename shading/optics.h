@@ -30,4 +30,20 @@ inline Color schlick(const Color& f0, float cos_theta) {
     return f0 + (Color(1.f) - f0) * c5;
 }
 
+/// The seed's mirror and transmission weights with the Fresnel option (--fresnel): the mirror
+/// weight kr follows Schlick's F(theta) of the normal-incidence reflectance ks, and transmission
+/// takes what is left, kt (1 - F) / (1 - ks). `cos_v` = N.V clamped to [0, 1].
+struct FresnelWeights {
+    Color kr, kt;
+};
+inline FresnelWeights schlick_weights(const Color& ks, const Color& kr, const Color& kt, float cos_v) {
+    const Color F = schlick(ks, cos_v);
+    FresnelWeights w;
+    for (int i = 0; i < 3; ++i) {
+        w.kr[i] = ks[i] > 0.f ? kr[i] * F[i] / ks[i] : 0.f;
+        w.kt[i] = ks[i] < 1.f ? kt[i] * (1.f - F[i]) / (1.f - ks[i]) : 0.f;
+    }
+    return w;
+}
+
 }  // namespace whitted

@@ -206,11 +206,9 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                 const float cos_v = std::clamp(dot(N, V), 0.f, 1.f);
                 if (m_settings.fresnel) {
                     // Schlick: the mirror weight follows F(theta) and transmission takes what is left.
-                    const Color F = schlick(c.ks, cos_v);
-                    for (int i = 0; i < 3; ++i) {
-                        kr[i] = c.ks[i] > 0.f ? c.kr[i] * F[i] / c.ks[i] : 0.f;
-                        kt[i] = c.ks[i] < 1.f ? c.kt[i] * (1.f - F[i]) / (1.f - c.ks[i]) : 0.f;
-                    }
+                    const FresnelWeights fw = schlick_weights(c.ks, c.kr, c.kt, cos_v);
+                    kr = fw.kr;
+                    kt = fw.kt;
                 }
                 // Hall & Greenberg (1983): a branch whose accumulated weight falls below min_weight
                 // cannot change the pixel visibly; it is not traced.

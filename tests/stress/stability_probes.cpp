@@ -771,11 +771,9 @@ public:
                 Color kr = c.kr, kt = c.kt;
                 const float cos_v = std::clamp(dot(N, V), 0.f, 1.f);
                 if (m_s.fresnel) {
-                    const Color F = schlick(c.ks, cos_v);
-                    for (int i = 0; i < 3; ++i) {
-                        kr[i] = c.ks[i] > 0.f ? c.kr[i] * F[i] / c.ks[i] : 0.f;
-                        kt[i] = c.ks[i] < 1.f ? c.kt[i] * (1.f - F[i]) / (1.f - c.ks[i]) : 0.f;
-                    }
+                    const FresnelWeights fw = schlick_weights(c.ks, c.kr, c.kt, cos_v);
+                    kr = fw.kr;
+                    kt = fw.kt;
                 }
                 const float wt = weight * max3(kt);
                 if (!is_black(kt) && wt >= m_s.min_weight) {
