@@ -118,6 +118,7 @@ struct RenderOptions {
     std::string input, output = "whitted.png";
     int width = 0, height = 0, camera = 0, scene = -1, max_depth = 5, tile_size = 32, threads = 0, bits = 0;
     std::string background = "0", ambient = "0.05", crop, accel = "embree", ocio_config, display, view = "Standard";
+    std::string precision, bv;  ///< in-house BVH options given as flags (appended to the --accel spec)
     std::vector<std::string> aovs;
     std::string aa = "adaptive", filter = "box";
     float aa_threshold = AaSettings{}.threshold;
@@ -128,6 +129,18 @@ struct RenderOptions {
     double max_memory_gb = 8.0;
     bool allow_outside_uris = false;
 };
+
+/// `--precision` and `--bv` are shorthands for the accelerator spec's options of the same names
+/// (`--accel bvh --precision double` == `--accel bvh:precision=double`): each given one is appended
+/// to the spec, whose parser rejects it, naming the backend, where it does not apply.
+std::string with_spec_options(std::string spec, std::initializer_list<std::pair<const char*, std::string>> options) {
+    for (const auto& [key, value] : options) {
+        if (value.empty()) continue;
+        spec += spec.find(':') == std::string::npos ? ':' : ',';
+        spec += fmt::format("{}={}", key, value);
+    }
+    return spec;
+}
 
 /// Scene-file render settings fill every option the command line did not give (`given(flag)`);
 /// flags always win. A relative output path is taken relative to the scene file (as pbrt does).
@@ -194,7 +207,7 @@ int run_render(RenderOptions o, const std::string& cmdline, Given&& given) {
     rs.aa.depth = o.aa_depth;
     rs.aa.spp = o.spp;
     rs.aa.filter = parse_pixel_filter(o.filter);
-    rs.accel = o.accel;
+    rs.accel = with_spec_options(o.accel, {{"precision", o.precision}, {"bv", o.bv}});
     rs.robust = o.robust;
     rs.progress = !o.no_progress;
 
@@ -346,6 +359,12 @@ int main(int argc, char** argv) {
     render->add_option("--accel", ro.accel,
                        "Acceleration structure: embree, bvh, grid, octree, kdop, brute; options after a colon, "
                        "e.g. bvh:precision=double,bv=sphere (docs/accelerators.md)")->capture_default_str();
+    render->add_option("--precision", ro.precision,
+                       "In-house BVH and brute force: trace in float or double (the reference), same as "
+                       "--accel bvh:precision=...")->check(CLI::IsMember({"float", "double"}));
+    render->add_option("--bv", ro.bv,
+                       "In-house BVH bounding volume: aabb or sphere (the seed's bounding spheres), same as "
+                       "--accel bvh:bv=...")->check(CLI::IsMember({"aabb", "sphere"}));
     render->add_flag("--robust", ro.robust, "Embree robust mode (RTC_SCENE_FLAG_ROBUST)");
     render->add_option("--ocio-config", ro.ocio_config, "OpenColorIO config (default: $OCIO, else the bundled one)");
     render->add_option("--display", ro.display, "OCIO display (default: the config's default)");

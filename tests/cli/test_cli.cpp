@@ -1,6 +1,7 @@
 // The `whitted` program end to end: exit codes, one-line errors, outputs written.
 #include <gtest/gtest.h>
 
+#include "cli_image.h"
 #include "cli_util.h"
 
 #include <sys/wait.h>
@@ -12,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -73,6 +75,29 @@ TEST(Cli, BadCameraIndexAndCropAreErrors) {
     r = run("render '" + kBox + "' --crop 1,2,3 -o /tmp/whitted_cli_crop.png --no-progress");
     EXPECT_EQ(r.code, 1);
     EXPECT_NE(r.err.find("--crop"), std::string::npos) << r.err;
+}
+
+// --precision and --bv are the accelerator spec's options as flags: the same image as the spec
+// form, and an error naming the spec where the backend has no such option.
+TEST(Cli, PrecisionAndBvFlagsAreSpecOptions) {
+    const fs::path a = fs::temp_directory_path() / "whitted_cli_prec_flag.exr";
+    const fs::path b = fs::temp_directory_path() / "whitted_cli_prec_spec.exr";
+    Result r = run("render '" + kBox + "' --width 24 --aa center --no-progress --exr-float --accel bvh --precision double "
+                   "--bv sphere -o '" + a.string() + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = run("render '" + kBox + "' --width 24 --aa center --no-progress --exr-float "
+            "--accel bvh:precision=double,bv=sphere -o '" + b.string() + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::vector<float> pa = whitted::test::read_pixels(a), pb = whitted::test::read_pixels(b);
+    ASSERT_FALSE(pa.empty());
+    EXPECT_EQ(pa, pb);
+    r = run("render '" + kBox + "' --width 24 --no-progress --accel embree --precision double --log-level error "
+            "-o /tmp/whitted_cli_p.png");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("embree:precision=double"), std::string::npos) << r.err;
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    r = run("render '" + kBox + "' --width 24 --no-progress --bv cube -o /tmp/whitted_cli_p.png");
+    EXPECT_EQ(r.code, 2) << r.err;
 }
 
 TEST(Cli, UnknownOutputExtensionIsAnErrorAndWritesNothing) {

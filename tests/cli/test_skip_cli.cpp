@@ -2,9 +2,9 @@
 // end through the executable (the way tests/cli/test_cli.cpp runs it).
 #include <gtest/gtest.h>
 
+#include "cli_image.h"
 #include "cli_util.h"
 
-#include <OpenImageIO/imageio.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -18,6 +18,7 @@
 namespace {
 
 namespace fs = std::filesystem;
+using whitted::test::read_pixels;
 using whitted::test::Result;
 using whitted::test::run;
 using whitted::test::slurp;
@@ -31,15 +32,6 @@ fs::path temp_dir() {
 
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
-std::vector<float> read_pixels(const fs::path& path) {
-    auto in = OIIO::ImageInput::open(path.string());
-    if (!in) return {};
-    const OIIO::ImageSpec& spec = in->spec();
-    std::vector<float> px(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
-    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data())) return {};
-    return px;
-}
 
 const std::string kScene = std::string(WHITTED_ASSETS_DIR) + "/scenes/whitted1980.json";
 
