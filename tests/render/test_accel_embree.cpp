@@ -25,7 +25,11 @@ using namespace whitted::test;
 
 const char* const kScenes[] = {"/scenes/default.glb", "/gltf/Duck/glTF-Binary/Duck.glb",
                                "/gltf/GlassHurricaneCandleHolder/glTF-Binary/GlassHurricaneCandleHolder.glb",
-                               "/gltf/SimpleInstancing/glTF-Binary/SimpleInstancing.glb"};
+                               "/gltf/SimpleInstancing/glTF-Binary/SimpleInstancing.glb",
+                               // The bundled scene files: analytic spheres (Embree user geometry),
+                               // planes beside the structure, the Duck included twice.
+                               "/scenes/whitted1980.json", "/scenes/glass_mirror_room.json",
+                               "/scenes/transparent_shadows.json"};
 
 Scene load(const char* rel) {
     ImportOptions io;
