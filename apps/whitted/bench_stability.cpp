@@ -39,6 +39,7 @@ struct BenchStabilityOptions {
     size_t points = 4000;                   ///< self-intersection surface points per case
     int threads = 0;                        ///< 0 = all cores
     std::string sections = "all";           ///< comma list: self,images,watertight,energy,refraction,deep,hiterror
+    std::vector<float> offset_ulps;         ///< self: sweep these offsets instead of the standard variants
 };
 
 /// One CSV row per measurement: section, case columns, metric, value.
@@ -94,13 +95,25 @@ void run_self_intersection(const BenchStabilityOptions& o, Csv& csv) {
     struct Variant {
         ProbeSurface surface;
         bool smooth, previous, exact;
+        float offset_ulps = 0.f;  ///< offset_ray_origin at this distance instead of kOffsetUlps (0: the renderer's)
     };
-    const Variant variants[] = {
+    std::vector<Variant> variants = {
         {ProbeSurface::MeshSphere, false, false, false}, {ProbeSurface::MeshSphere, false, true, false},
         {ProbeSurface::MeshSphere, false, false, true},  {ProbeSurface::MeshSphere, true, false, false},
         {ProbeSurface::AnalyticSphere, false, false, false}, {ProbeSurface::AnalyticSphere, false, true, false},
         {ProbeSurface::TiltedQuad, false, false, false}, {ProbeSurface::TiltedQuad, false, true, false},
         {ProbeSurface::TiltedQuad, false, false, true},
+    };
+    // --offset-ulps: the renderer's hit points with other offset distances (is a smaller one safe?).
+    if (!o.offset_ulps.empty()) {
+        variants.clear();
+        for (const float u : o.offset_ulps)
+            for (const ProbeSurface s : {ProbeSurface::MeshSphere, ProbeSurface::AnalyticSphere, ProbeSurface::TiltedQuad})
+                variants.push_back({s, false, false, false, u});
+    }
+    auto offset_name = [](const Variant& v) {
+        return v.previous ? std::string("previous (W&B 2019)")
+                          : v.offset_ulps > 0.f ? fmt::format("{:g} ulp", v.offset_ulps) : std::string("current");
     };
     for (const char* accel : {"bvh", "embree"})
         for (const Variant& v : variants) {
@@ -122,8 +135,11 @@ void run_self_intersection(const BenchStabilityOptions& o, Csv& csv) {
                         c.points = o.points;
                         c.gap_ulps = gap;
                         if (v.previous) c.offset = previous_offset;
+                        if (v.offset_ulps > 0.f)
+                            c.offset = [u = v.offset_ulps](const Vec3f& p, const Vec3f& n) { return offset_ray_origin(p, n, u); };
                         SelfIntersectionResult r = probe_self_intersection(c);
                         const std::string subject = surface_name(v.surface, v.smooth) + (v.previous ? " / previous offset" : "") +
+                                                    (v.offset_ulps > 0.f ? fmt::format(" / offset {:g} ulp", v.offset_ulps) : "") +
                                                     (v.exact ? " / double hit point" : "") + fmt::format(" / gap {:g} ulp", gap);
                         const uint64_t n = r.rays[0] + r.rays[1] + r.rays[2];
                         const uint64_t sh = r.self_hits[0] + r.self_hits[1] + r.self_hits[2];
@@ -153,8 +169,8 @@ void run_self_intersection(const BenchStabilityOptions& o, Csv& csv) {
                     }
                 }
             std::printf("| %s | %s | %s | %s | %llu | %llu | %llu | %llu | [%.1f, %.1f] | %.1f | %.2g |\n", accel,
-                        surface_name(v.surface, v.smooth).c_str(), v.previous ? "previous (W&B 2019)" : "current",
-                        v.exact ? "double (proposed)" : "SceneView (float)", (unsigned long long)rays,
+                        surface_name(v.surface, v.smooth).c_str(), offset_name(v).c_str(),
+                        v.exact ? "double (probe emulation)" : "SceneView", (unsigned long long)rays,
                         (unsigned long long)self, (unsigned long long)miss4, (unsigned long long)miss12,
                         off_min == 1e300 ? 0.0 : off_min, off_max, perr, nerr);
             std::fflush(stdout);
@@ -381,6 +397,11 @@ Command register_bench_stability(CLI::App& bench) {
     app->add_option("--points", o->points, "Surface points per self-intersection case")
         ->check(CLI::Range(size_t(1), size_t(1) << 30))->capture_default_str();
     app->add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 1024))->capture_default_str();
+    app->add_option("--offset-ulps", o->offset_ulps,
+                    "Self-intersection: sweep these ray-offset distances (ulps of max|p|) with the renderer's hit points "
+                    "instead of the standard variants")
+        ->delimiter(',')
+        ->check(CLI::Range(0.01f, 4096.f));
     app->add_option("--sections", o->sections, "Comma list of self,images,watertight,energy,refraction,deep,hiterror or all")
         ->capture_default_str();
     return Command{app, [o] { return run_bench_stability(*o); }};

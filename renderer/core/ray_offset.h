@@ -11,12 +11,13 @@
 //   - No absolute offset of 1/65536 near the world origin: it is 15 % of the size of a 1e-4 scene
 //     (rays tunnelled through whole objects). Below |p| ~ 1e-31 the unit is FLT_MIN, so that
 //     flush-to-zero / denormals-are-zero (set in every render thread) cannot cancel the offset.
-// Guarantee (tests/stress/test_stress_self_intersection.cpp): with hit points whose error is at
-// most ~3 ulp(max|p|) (SceneView), no secondary ray re-hits its own surface at any scale from 1e-4
-// to 1e6 and any translation up to 1e5, and every surface more than kGuaranteedGapUlps ulps away
-// in front of the origin is still hit. Hit points computed with cancellation (a point near the
-// world origin on a triangle whose vertices are far larger) have a larger error than this
-// assumes; see docs/numerical-stability.md ("What is not guaranteed").
+// Guarantee (tests/stress/test_stress_self_intersection.cpp): with SceneView's hit points (computed
+// in double, at most ~0.8 ulp(max|p|) off the surface), no secondary ray re-hits its own surface at
+// any scale from 1e-4 to 1e6 and any translation up to 1e5, and every surface more than
+// kGuaranteedGapUlps ulps away in front of the origin is still hit. Why not less than 4 ulps
+// (`whitted bench stability --offset-ulps`, docs/numerical-stability.md section 1): 3 ulps still
+// self-hits on objects that collapse to a few float steps, 1-2 ulps also on resolvable ones, and
+// no offset reaches neighbours 4 ulps away (origins end over a ~3-ulp spread of distances).
 #pragma once
 
 #include <bit>
@@ -52,13 +53,23 @@ inline float step_towards(float x, float dir) {
 /// (measured bound, tests/stress: offset + rounding + hit-point error, with a margin).
 constexpr float kGuaranteedGapUlps = 12.f;
 
+/// kGuaranteedGapUlps ulps of max|p| as a distance: a secondary ray leaving p meets every surface
+/// farther than this from p's surface and may skip nearer ones (touching dielectrics look for
+/// those explicitly, renderer/integrator/whitted_integrator.cpp).
+inline float guaranteed_gap(const Vec3f& p) { return kGuaranteedGapUlps * detail::offset_unit(p); }
+
 /// Moves p off its surface to the side the unit normal n points to (flip n to leave the other way):
-/// kOffsetUlps ulps of max|p| along n, each moved coordinate then rounded one step further away.
-inline Vec3f offset_ray_origin(const Vec3f& p, const Vec3f& n) {
-    const float d = detail::kOffsetUlps * detail::offset_unit(p);
+/// `ulps` ulps of max|p| along n, each moved coordinate then rounded one step further away. The
+/// renderer uses kOffsetUlps (the overload below); other distances are for the stress sweep
+/// (`whitted bench stability --offset-ulps`).
+inline Vec3f offset_ray_origin(const Vec3f& p, const Vec3f& n, float ulps) {
+    const float d = ulps * detail::offset_unit(p);
     Vec3f o = p + n * d;
     for (int k = 0; k < 3; ++k) o[k] = detail::step_towards(o[k], n[k]);
     return o;
 }
+
+/// offset_ray_origin by kOffsetUlps: what every secondary ray of the renderer uses.
+inline Vec3f offset_ray_origin(const Vec3f& p, const Vec3f& n) { return offset_ray_origin(p, n, detail::kOffsetUlps); }
 
 }  // namespace whitted

@@ -1,9 +1,13 @@
 #include "renderer/integrator/whitted_integrator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <limits>
+#include <optional>
 #include <span>
 #include <utility>
+#include <vector>
 
 #include "renderer/core/error.h"
 #include "renderer/core/ray_offset.h"
@@ -63,6 +67,249 @@ constexpr KernelFeatures kKernels[] = {
 
 }  // namespace
 
+// ---------------------------------------------------------------------------------------------
+// Touching dielectrics (docs/numerical-stability.md, StressRefraction.TouchingSlabsActAsOne).
+//
+// Two dielectrics that share a face meet there with coincident, opposite-facing surfaces. The
+// accelerator reports one of the two (both are at the same t, so which one is arbitrary), and the
+// refracted ray, moved a few ulps past the shared plane (ray_offset.h), starts inside the second
+// medium and never meets its face: it crosses the second medium bent as if it had left into air.
+// A closest-hit query cannot list coincident surfaces (ties), but their orientation tells them
+// apart: a probe leaving the surface hit along its outward normal sees that surface from behind
+// and the face of a medium beginning there from the front. DielectricContacts is a small
+// structure over the non-thin dielectrics that may touch another one, queried with a filter that
+// accepts front faces only. The two faces are then crossed as one interface with the relative ior
+// of the two media: the limit of a vanishing gap (a gap far thinner than a wavelength cannot
+// totally reflect: frustrated total internal reflection). pbrt and Mitsuba leave this to the
+// scene (one interface with an exterior ior); production renderers ask for overlapping volumes
+// with priorities (Schmidt & Budge 2002). A mesh that can only touch itself (two glass parts in
+// one mesh) is not a candidate: candidates come from pairs of objects (DielectricContacts::find).
+class DielectricContacts final : public SurfaceFilter {
+public:
+    /// The surface of another medium found at a hit point, in the scene's ids.
+    struct Contact {
+        Hit hit;        ///< on the other medium's surface
+        Ray probe;      ///< the query that found it (for SceneView::surface)
+    };
+
+    /// Null when no two non-thin dielectrics of the scene can touch (nothing to look for).
+    static std::shared_ptr<const DielectricContacts> find(const SceneView& view);
+
+    /// True when object `o` (object_index) may touch another non-thin dielectric.
+    bool candidate(uint32_t o) const { return m_candidate[o] != 0; }
+
+    /// The front face of another non-thin dielectric within guaranteed_gap(p) of p, found by a
+    /// probe from just inside the surface hit along its outward unit normal.
+    std::optional<Contact> at(const Vec3f& p, const Vec3f& outward) const {
+        const float reach = guaranteed_gap(p);
+        Contact c;
+        c.probe.org = p - outward * reach;
+        c.probe.dir = outward;
+        c.probe.tfar = 2.f * reach;
+        c.hit = m_accel->intersect(c.probe, RayKind::Refraction);
+        if (!c.hit.valid()) return std::nullopt;
+        const bool mesh = c.hit.geom < m_sub.meshes.size();
+        c.hit.inst = mesh ? m_inst[c.hit.inst] : kInvalidId;
+        c.hit.geom = m_geom[c.hit.geom];
+        return c;
+    }
+
+    // SurfaceFilter: front faces only, by the same winding rule as SceneView (ng from the world
+    // vertices in double; spheres: outward; planes: `normal`).
+    bool accept(const Ray& ray, const Hit& hit, RayKind) const override {
+        const Vec3d d(ray.dir);
+        switch (m_sub.geom_kind(hit.geom)) {
+            case GeomKind::Mesh: {
+                const Mesh& mesh = m_sub.meshes[hit.geom];
+                const Mat4d& w = m_sub.instances[hit.inst].world_from_object;
+                const uint32_t* idx = &mesh.indices[size_t(hit.prim) * 3];
+                const Vec3d p0 = w.apply_point(Vec3d(mesh.positions[idx[0]]));
+                const Vec3d p1 = w.apply_point(Vec3d(mesh.positions[idx[1]]));
+                const Vec3d p2 = w.apply_point(Vec3d(mesh.positions[idx[2]]));
+                return dot(cross(p1 - p0, p2 - p0), d) < 0.0;
+            }
+            case GeomKind::Sphere: {
+                const Sphere& s = m_sub.spheres[hit.geom - m_sub.meshes.size()];
+                return dot(Vec3d(ray.org) + d * double(hit.t) - s.center, d) < 0.0;
+            }
+            case GeomKind::Plane:
+                return dot(m_sub.planes[hit.geom - m_sub.meshes.size() - m_sub.spheres.size()].normal, d) < 0.0;
+        }
+        return false;
+    }
+    Color transmittance(const Ray&, const Hit&) const override { return Color(0.f); }  // never asked
+    uint32_t mesh_flags(uint32_t) const override { return kNeedsAccept; }
+
+private:
+    Scene m_sub;                          ///< the candidate objects (positions and indices only)
+    std::vector<uint32_t> m_geom;         ///< scene geometry id per m_sub geometry id
+    std::vector<uint32_t> m_inst;         ///< scene instance per m_sub instance
+    std::vector<uint8_t> m_candidate;     ///< per scene object (object_index): may touch another
+    std::unique_ptr<Accelerator> m_accel; ///< "bvh" over m_sub, with this filter
+};
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// One non-thin dielectric object for the touching test.
+struct DielectricObject {
+    uint32_t object;                      ///< object_index
+    GeomKind kind;
+    Bounds3d bounds;                      ///< world space (planes: infinite)
+    const Sphere* sphere = nullptr;
+    const Plane* plane = nullptr;
+};
+
+/// Distance within which two surfaces count as touching: twice the probe's reach at magnitude m
+/// (float spacing of m times 2 kGuaranteedGapUlps), so rounding of either surface cannot hide a
+/// contact the probe would find.
+double touch_tolerance(double m) { return 2.0 * double(kGuaranteedGapUlps) * std::max(m, 1e-30) * 0x1p-23; }
+
+double magnitude(const Bounds3d& b) {
+    return std::max({std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z), std::fabs(b.hi.x), std::fabs(b.hi.y),
+                     std::fabs(b.hi.z)});
+}
+
+/// Signed distances of a box's corners from a plane: [min, max].
+std::pair<double, double> plane_extent(const Plane& p, const Bounds3d& b) {
+    double lo = kInf, hi = -kInf;
+    for (int c = 0; c < 8; ++c) {
+        const Vec3d corner{(c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z};
+        const double d = dot(p.normal, corner - p.point);
+        lo = std::min(lo, d);
+        hi = std::max(hi, d);
+    }
+    return {lo, hi};
+}
+
+/// Whether two dielectric objects can share a face: exact for spheres and planes, overlapping
+/// bounds (conservative) for meshes.
+bool may_touch(const DielectricObject& a, const DielectricObject& b) {
+    if (a.kind == GeomKind::Plane && b.kind == GeomKind::Plane) {
+        const double tol = touch_tolerance(std::max(magnitude({a.plane->point, a.plane->point}),
+                                                    magnitude({b.plane->point, b.plane->point})));
+        return length(cross(a.plane->normal, b.plane->normal)) <= 1e-6 &&
+               std::fabs(dot(a.plane->normal, b.plane->point - a.plane->point)) <= tol;
+    }
+    if (b.kind == GeomKind::Plane) return may_touch(b, a);
+    if (a.kind == GeomKind::Plane) {
+        const double tol = touch_tolerance(std::max(magnitude(b.bounds), magnitude({a.plane->point, a.plane->point})));
+        if (b.kind == GeomKind::Sphere)
+            return std::fabs(std::fabs(dot(a.plane->normal, b.sphere->center - a.plane->point)) - b.sphere->radius) <= tol;
+        const auto [lo, hi] = plane_extent(*a.plane, b.bounds);
+        return lo <= tol && hi >= -tol;
+    }
+    const double tol = touch_tolerance(std::max(magnitude(a.bounds), magnitude(b.bounds)));
+    if (a.kind == GeomKind::Sphere && b.kind == GeomKind::Sphere) {
+        // Outside each other (external tangency) or one inside the other (internal tangency).
+        const double d = length(a.sphere->center - b.sphere->center);
+        const double ra = a.sphere->radius, rb = b.sphere->radius;
+        return std::fabs(d - (ra + rb)) <= tol || std::fabs(d - std::fabs(ra - rb)) <= tol;
+    }
+    for (int k = 0; k < 3; ++k)
+        if (a.bounds.lo[k] > b.bounds.hi[k] + tol || b.bounds.lo[k] > a.bounds.hi[k] + tol) return false;
+    return true;
+}
+
+}  // namespace
+
+std::shared_ptr<const DielectricContacts> DielectricContacts::find(const SceneView& view) {
+    const Scene& scene = view.scene();
+    const SceneAnalysis& analysis = view.analysis();
+    auto dielectric = [&](uint32_t material) {
+        const MaterialFeatures& mf = analysis.materials[material];
+        return mf.transmission && !mf.constant.thin;  // `thin` does not vary over a surface
+    };
+    // The non-thin dielectric objects, with world bounds.
+    std::vector<DielectricObject> objects;
+    std::vector<Bounds3d> mesh_bounds(scene.meshes.size());
+    for (uint32_t i = 0; i < scene.instances.size(); ++i) {
+        const Instance& inst = scene.instances[i];
+        const Mesh& mesh = scene.meshes[inst.mesh];
+        if (!dielectric(mesh.material) || mesh.indices.empty()) continue;
+        Bounds3d& mb = mesh_bounds[inst.mesh];
+        if (mb.empty())
+            for (const Vec3f& p : mesh.positions) mb.extend(Vec3d(p));
+        DielectricObject o{object_index(scene, inst.mesh, i), GeomKind::Mesh, {}};
+        for (int c = 0; c < 8; ++c)
+            o.bounds.extend(inst.world_from_object.apply_point(
+                {(c & 1) ? mb.hi.x : mb.lo.x, (c & 2) ? mb.hi.y : mb.lo.y, (c & 4) ? mb.hi.z : mb.lo.z}));
+        objects.push_back(o);
+    }
+    for (size_t i = 0; i < scene.spheres.size(); ++i) {
+        const Sphere& s = scene.spheres[i];
+        if (!dielectric(s.material)) continue;
+        const uint32_t g = scene.sphere_geom_id(i);
+        DielectricObject o{object_index(scene, g, kInvalidId), GeomKind::Sphere, {}};
+        o.bounds.extend(s.center - Vec3d(s.radius));
+        o.bounds.extend(s.center + Vec3d(s.radius));
+        o.sphere = &s;
+        objects.push_back(o);
+    }
+    for (size_t i = 0; i < scene.planes.size(); ++i) {
+        const Plane& p = scene.planes[i];
+        if (!dielectric(p.material)) continue;
+        DielectricObject o{object_index(scene, scene.plane_geom_id(i), kInvalidId), GeomKind::Plane, {}};
+        o.bounds = {Vec3d(-kInf), Vec3d(kInf)};
+        o.plane = &p;
+        objects.push_back(o);
+    }
+    // Pairs that may touch (a handful of dielectric objects in practice: quadratic is fine).
+    std::vector<uint8_t> candidate(analysis.object_count, 0);
+    bool any = false;
+    for (size_t a = 0; a < objects.size(); ++a)
+        for (size_t b = a + 1; b < objects.size(); ++b)
+            if (may_touch(objects[a], objects[b])) {
+                candidate[objects[a].object] = candidate[objects[b].object] = 1;
+                any = true;
+            }
+    if (!any) return nullptr;
+
+    // The candidates as a scene of their own (geometry only), in scene order.
+    auto c = std::make_shared<DielectricContacts>();
+    c->m_candidate = std::move(candidate);
+    Scene& sub = c->m_sub;
+    sub.materials.resize(1);
+    std::vector<uint32_t> sub_mesh(scene.meshes.size(), kInvalidId);
+    for (uint32_t i = 0; i < scene.instances.size(); ++i) {
+        const Instance& inst = scene.instances[i];
+        if (!c->m_candidate[object_index(scene, inst.mesh, i)]) continue;
+        if (sub_mesh[inst.mesh] == kInvalidId) {
+            sub_mesh[inst.mesh] = uint32_t(sub.meshes.size());
+            Mesh m;
+            m.name = scene.meshes[inst.mesh].name;
+            m.positions = scene.meshes[inst.mesh].positions;
+            m.indices = scene.meshes[inst.mesh].indices;
+            sub.meshes.push_back(std::move(m));
+            c->m_geom.push_back(inst.mesh);
+        }
+        Instance si = inst;
+        si.mesh = sub_mesh[inst.mesh];
+        sub.instances.push_back(si);
+        c->m_inst.push_back(i);
+    }
+    for (size_t i = 0; i < scene.spheres.size(); ++i) {
+        const uint32_t g = scene.sphere_geom_id(i);
+        if (!c->m_candidate[object_index(scene, g, kInvalidId)]) continue;
+        Sphere s = scene.spheres[i];
+        s.material = 0;
+        sub.spheres.push_back(s);
+        c->m_geom.push_back(g);
+    }
+    for (size_t i = 0; i < scene.planes.size(); ++i) {
+        const uint32_t g = scene.plane_geom_id(i);
+        if (!c->m_candidate[object_index(scene, g, kInvalidId)]) continue;
+        Plane p = scene.planes[i];
+        p.material = 0;
+        sub.planes.push_back(p);
+        c->m_geom.push_back(g);
+    }
+    // The in-house BVH: deterministic and watertight (docs/accelerators.md).
+    c->m_accel = create_accelerator("bvh", c->m_sub, *c);
+    return c;
+}
+
 WhittedIntegrator::WhittedIntegrator(const SceneView& view, const Accelerator& accel, const IntegratorSettings& settings)
     : m_view(view), m_accel(accel), m_settings(settings),
       m_kernel(select_kernel(view.analysis().features, settings)) {
@@ -72,6 +319,7 @@ WhittedIntegrator::WhittedIntegrator(const SceneView& view, const Accelerator& a
     };
     pick(std::make_index_sequence<std::size(kKernels)>{});
     RT_CHECK(m_trace != nullptr);
+    if (m_kernel.transmission) m_contacts = DielectricContacts::find(view);
 }
 
 template <KernelFeatures K>
@@ -100,6 +348,18 @@ void WhittedIntegrator::probe(const Ray& ray, RayCounters& counters, PrimaryInfo
     primary.albedo = c.kd + c.kr + c.kt;
     primary.prim = hit.prim;
     primary.inst = hit.inst;
+}
+
+std::optional<WhittedIntegrator::OtherMedium> WhittedIntegrator::other_medium(const Hit& hit, const SurfacePoint& sp,
+                                                                               RayCounters& counters) const {
+    const Scene& scene = m_view.scene();
+    if (!m_contacts->candidate(object_index(scene, hit.geom, hit.inst))) return std::nullopt;
+    ++counters.contact_probe;
+    const auto contact = m_contacts->at(sp.p, sp.ng);  // along the outward normal of the surface hit
+    if (!contact) return std::nullopt;
+    const MaterialFeatures& mf = m_view.analysis().materials[scene.geom_material(contact->hit.geom)];
+    const SurfacePoint so = m_view.surface(contact->probe, contact->hit);
+    return OtherMedium{mf.varying ? m_view.coefficients(so) : mf.constant, so.p};
 }
 
 // The kernel. Every `if constexpr` below removes work a scene cannot need; the operations that
@@ -133,6 +393,15 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
     const Vec3f Ng = front ? sp.ng : -sp.ng;
     Vec3f N = front ? sp.ns : -sp.ns;
     if (dot(N, V) <= 0.f) N = Ng;  // shading normal facing away from the viewer: fall back
+
+    // Touching dielectrics (DielectricContacts): the medium on the far side of this surface may
+    // begin right here. `other` is that medium, entered when this one is left and left when this
+    // one is entered.
+    std::optional<OtherMedium> other;
+    if constexpr (K.transmission) {
+        if (m_contacts && !c.thin && !is_black(c.kt)) [[unlikely]]
+            other = other_medium(hit, sp, counters);
+    }
 
     if (primary) {
         primary->hit = true;
@@ -213,7 +482,9 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                 // Hall & Greenberg (1983): a branch whose accumulated weight falls below min_weight
                 // cannot change the pixel visibly; it is not traced.
                 if constexpr (K.transmission) {
-                    const float wt = weight * max_component(kt);
+                    // Through a shared face, the light crosses both surfaces.
+                    const Color kt_through = other ? kt * other->c.kt : kt;
+                    const float wt = weight * max_component(kt_through);
                     if (!is_black(kt) && wt < m_settings.min_weight) ++counters.secondary_skipped_cutoff;
                     if (!is_black(kt) && wt >= m_settings.min_weight) {
                         Ray t;
@@ -222,14 +493,22 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                         if (c.thin) {
                             t.dir = ray.dir;  // thin-walled: straight through
                         } else {
-                            const float eta = front ? 1.f / c.ior : c.ior;
+                            float eta = front ? 1.f / c.ior : c.ior;
+                            if (other) {
+                                // One interface between the two media: n_from / n_to in one step
+                                // (no total internal reflection in a gap of zero width), and the ray
+                                // starts past both surfaces.
+                                eta *= front ? other->c.ior : 1.f / other->c.ior;
+                                const Vec3f past_other = offset_ray_origin(other->p, -Ng);
+                                if (dot(past_other - t.org, Ng) < 0.f) t.org = past_other;
+                            }
                             auto dir = refract(ray.dir, N, eta);
                             if (dir && dot(*dir, Ng) < 0.f) t.dir = *dir;
                             else transmitted = false;  // total internal reflection
                         }
                         if (transmitted) {
-                            result += kt * trace_kernel<K>(t, RayKind::Refraction, depth + 1, counters, nullptr,
-                                                           secondary, wt);
+                            result += kt_through * trace_kernel<K>(t, RayKind::Refraction, depth + 1, counters, nullptr,
+                                                                   secondary, wt);
                         } else {
                             kr += kt;  // the transmitted energy goes to reflection
                         }
@@ -252,6 +531,8 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
     if constexpr (K.transmission) {
         // Beer-Lambert: leaving a volume, the light travelled `t` inside it.
         if (!front && !c.thin && !is_black(c.absorption)) result *= exp_neg(c.absorption * hit.t);
+        // Entering this medium from a touching one: the light travelled `t` inside that one.
+        if (front && other && !is_black(other->c.absorption)) result *= exp_neg(other->c.absorption * hit.t);
 
         // alpha BLEND: partial coverage mixed with what lies straight behind.
         if (mat.model == MaterialModel::GltfPbr && mat.alpha_mode == AlphaMode::Blend) {

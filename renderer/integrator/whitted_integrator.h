@@ -9,6 +9,8 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <string>
 
 #include "renderer/accel/accelerator.h"
@@ -52,10 +54,13 @@ std::string kernel_name(const KernelFeatures& k);
 /// centre sample. The `*_skipped` counters are not rays: shadow rays not cast because the light
 /// cannot reach the point (beyond its range, outside its cone or culled per object by the scene
 /// analysis: `unreached`) or lies behind the surface (N.L <= 0: `facing`), and secondary rays
-/// not traced because their weight fell below min_weight (`cutoff`).
+/// not traced because their weight fell below min_weight (`cutoff`). `contact_probe` counts the
+/// short queries for a touching dielectric's coincident face (in the integrator's own small
+/// structure, not the scene's accelerator; not in total()).
 struct RayCounters {
     uint64_t camera = 0, shadow = 0, reflection = 0, refraction = 0, aov_probe = 0;
     uint64_t shadow_skipped_unreached = 0, shadow_skipped_facing = 0, secondary_skipped_cutoff = 0;
+    uint64_t contact_probe = 0;
     uint64_t total() const { return camera + shadow + reflection + refraction + aov_probe; }
     uint64_t secondary() const { return reflection + refraction; }
     RayCounters& operator+=(const RayCounters& o) {
@@ -64,6 +69,7 @@ struct RayCounters {
         shadow_skipped_unreached += o.shadow_skipped_unreached;
         shadow_skipped_facing += o.shadow_skipped_facing;
         secondary_skipped_cutoff += o.secondary_skipped_cutoff;
+        contact_probe += o.contact_probe;
         return *this;
     }
 };
@@ -77,9 +83,14 @@ struct PrimaryInfo {
     uint32_t prim = kInvalidId, inst = kInvalidId;
 };
 
+/// Where non-thin dielectrics of a scene touch (coincident faces): see whitted_integrator.cpp.
+class DielectricContacts;
+
 class WhittedIntegrator {
 public:
-    /// Selects the kernel for the view's scene (select_kernel) once.
+    /// Selects the kernel for the view's scene (select_kernel) once. When two non-thin dielectrics
+    /// of the scene may touch (bounds within a few ulps; spheres and planes tested exactly), also
+    /// builds a small structure over those objects to find their shared faces (an in-house BVH).
     WhittedIntegrator(const SceneView& view, const Accelerator& accel, const IntegratorSettings& settings);
 
     /// Radiance arriving along `ray` (a unit-direction ray of the given kind at tree depth
@@ -98,6 +109,9 @@ public:
     const IntegratorSettings& settings() const { return m_settings; }
     /// The kernel selected for this scene and settings.
     const KernelFeatures& kernel() const { return m_kernel; }
+    /// True when some non-thin dielectrics may touch, so refraction events on them look for a
+    /// coincident face of the other medium (false: no query, no cost).
+    bool handles_touching_dielectrics() const { return m_contacts != nullptr; }
 
 private:
     using TraceFn = Color (WhittedIntegrator::*)(const Ray&, RayKind, int, RayCounters&, PrimaryInfo*, const RayCone&,
@@ -110,12 +124,21 @@ private:
                 const RayCone& cone, float weight) const;
     template <KernelFeatures K>
     static TraceFn kernel_entry() { return &WhittedIntegrator::trace_kernel<K>; }
+    /// The medium of a touching dielectric whose face coincides with the surface hit (see
+    /// DielectricContacts): its coefficients there and the point on its face.
+    struct OtherMedium {
+        WhittedCoeffs c;
+        Vec3f p;
+    };
+    /// Looks for it at a hit on a non-thin dielectric (out of line, off the kernels' hot path).
+    std::optional<OtherMedium> other_medium(const Hit& hit, const SurfacePoint& sp, RayCounters& counters) const;
 
     const SceneView& m_view;
     const Accelerator& m_accel;
     IntegratorSettings m_settings;
     KernelFeatures m_kernel;
     TraceFn m_trace = nullptr;
+    std::shared_ptr<const DielectricContacts> m_contacts;  ///< null when no dielectrics touch
 };
 
 }  // namespace whitted
