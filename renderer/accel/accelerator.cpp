@@ -87,6 +87,11 @@ private:
 
 }  // namespace
 
+void Accelerator::intersect(std::span<const Ray> rays, RayKind kind, std::span<Hit> hits) const {
+    RT_CHECK_EQ(rays.size(), hits.size());
+    for (size_t i = 0; i < rays.size(); ++i) hits[i] = intersect(rays[i], kind);
+}
+
 const std::vector<std::string>& accelerator_names() {
     static const std::vector<std::string> names{"embree", "bvh", "grid", "octree", "kdop", "brute"};
     return names;
@@ -99,8 +104,17 @@ std::unique_ptr<Accelerator> create_backend(const std::string& name, const Scene
                                             const AccelConfig& config) {
     AccelSpec spec(name);
     if (spec.name() == "embree") {
-        spec.check_all_used("none");
-        return create_embree_accelerator(scene, filter, EmbreeConfig{config.robust, config.threads});
+        EmbreeConfig c{config.robust, config.threads};
+        if (const std::string* p = spec.find("packet")) {
+            if (*p == "1" || *p == "4" || *p == "8" || *p == "16") c.packet_width = std::stoi(*p);
+            else throw Error(fmt::format("accelerator '{}': packet must be 1, 4, 8 or 16", name));
+        }
+        if (const std::string* k = spec.find("compact")) {
+            if (*k == "0" || *k == "1") c.compact = *k == "1";
+            else throw Error(fmt::format("accelerator '{}': compact must be 0 or 1", name));
+        }
+        spec.check_all_used("packet, compact");
+        return create_embree_accelerator(scene, filter, c);
     }
     if (spec.name() == "bvh") {
         BvhConfig c;

@@ -3,6 +3,7 @@
 // How to use:
 //   auto accel = create_accelerator("embree", scene, filter, config);   // builds once
 //   Hit h = accel->intersect(ray, RayKind::Camera);                      // closest hit
+//   accel->intersect(std::span(rays), RayKind::Camera, std::span(hits));  // a batch (packets)
 //   Color s = accel->transmittance(shadow_ray);                          // product of Kt along it
 //   auto ref = create_accelerator("bvh:precision=double", scene, filter); // double-precision reference
 //
@@ -23,6 +24,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -73,10 +75,18 @@ public:
     /// What geometry `geom` (mesh, sphere or plane id) needs from traversal: a combination of the
     /// SurfaceFilter::k* flags. Backends skip the filter calls a geometry does not need (a plain
     /// opaque one needs none). The name predates spheres and planes.
+    ///
+    /// The two flags are independent, one per query: kNeedsAccept is read by closest-hit queries
+    /// only, kNeedsTransmittance by shadow queries only. Shadow rays never call accept(); a
+    /// geometry without kNeedsTransmittance blocks a shadow ray at its first crossing, whatever
+    /// accept() would say. So a geometry that lets light through anywhere (alpha-mask cut-outs,
+    /// where transmittance() returns 1, as well as transparent surfaces) must set
+    /// kNeedsTransmittance; single-sided opaque surfaces set kNeedsAccept alone (back faces are
+    /// culled for camera rays only) and get a filter-free occlusion query.
     virtual uint32_t mesh_flags(uint32_t geom) const = 0;
 
-    static constexpr uint32_t kNeedsAccept = 1u;         ///< call accept() on closest-hit candidates
-    static constexpr uint32_t kNeedsTransmittance = 2u;  ///< call transmittance() on shadow candidates
+    static constexpr uint32_t kNeedsAccept = 1u;         ///< closest hit: call accept() on candidates
+    static constexpr uint32_t kNeedsTransmittance = 2u;  ///< shadow: call transmittance() on candidates
 };
 
 /// Counters a backend keeps (summed over threads by the caller).
@@ -93,6 +103,12 @@ public:
     virtual ~Accelerator() = default;
     /// Closest accepted hit along [tnear, tfar], or an invalid Hit.
     virtual Hit intersect(const Ray& ray, RayKind kind) const = 0;
+    /// Closest hits of a batch of rays of one kind (hits.size() == rays.size(), else throws):
+    /// hits[i] is intersect(rays[i], kind), except that where several primitives meet at the
+    /// closest t (shared edges and vertices) the batch may name another of them. Coherent rays
+    /// (a row of camera samples) are what it is for: the Embree backend traces them as packets;
+    /// the default loops over intersect().
+    virtual void intersect(std::span<const Ray> rays, RayKind kind, std::span<Hit> hits) const;
     /// Product of the transmittances of the distinct surfaces crossed in [tnear, tfar]; each
     /// crossing counts once (de-duplicated per (geom, inst) within a few-ulp t window). Returns
     /// exactly 0 as soon as an opaque surface is found.
@@ -112,9 +128,10 @@ struct AccelConfig {
 const std::vector<std::string>& accelerator_names();
 
 /// Builds the named backend: "embree", "bvh", "grid", "octree", "kdop" or "brute" (the O(n)
-/// oracle), optionally followed by options, e.g. "bvh:precision=double,bv=sphere" or
-/// "grid:lambda=8" (docs/accelerators.md lists them). Throws whitted::Error naming the valid
-/// choices for an unknown name or option.
+/// oracle), optionally followed by options, e.g. "bvh:precision=double,bv=sphere",
+/// "grid:lambda=8" or "embree:packet=8,compact=1" (docs/accelerators.md lists them). Throws
+/// whitted::Error naming the valid choices for an unknown name or option. `scene` and `filter` must outlive the accelerator,
+/// unchanged: backends may keep references to them (Embree shares the meshes' index arrays).
 std::unique_ptr<Accelerator> create_accelerator(const std::string& name, const Scene& scene,
                                                 const SurfaceFilter& filter, const AccelConfig& config = {});
 

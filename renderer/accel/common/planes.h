@@ -5,17 +5,20 @@
 //     a hit up to it (a backend hit at exactly the same t wins);
 //   - transmittance: the planes' crossings (each plane is crossed at most once), then the
 //     backend's transmittance; exactly 0 as soon as an opaque surface is found.
-// Filter semantics are those of meshes (queries.h): accept() only with kNeedsAccept; a shadow
-// ray stops at a plane with neither kNeedsTransmittance nor kNeedsAccept.
+// Filter semantics are those of meshes (queries.h): accept() only with kNeedsAccept, for closest
+// hits; a shadow ray stops at a plane without kNeedsTransmittance.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/accel/common/geometry.h"
+#include "renderer/core/error.h"
 #include "renderer/scene/scene.h"
 
 namespace whitted {
@@ -36,6 +39,7 @@ inline bool intersect_plane(const Ray& ray, const Vec3d& point, const Vec3d& nor
 /// Adds a scene's infinite planes to a backend that knows only finite geometry.
 class PlaneDecorator final : public Accelerator {
 public:
+    using Accelerator::intersect;
     /// Takes ownership of `inner`, which was built for the same scene and filter.
     PlaneDecorator(std::unique_ptr<Accelerator> inner, const Scene& scene, const SurfaceFilter& filter)
         : m_inner(std::move(inner)), m_filter(filter) {
@@ -49,20 +53,30 @@ public:
 
     Hit intersect(const Ray& ray, RayKind kind) const override {
         if (!ray_is_traceable(ray)) return Hit{};
-        // The nearest accepted plane hit (lowest index on equal t).
-        Hit best;
-        Ray clipped = ray;
-        for (const PlaneData& p : m_planes) {
-            float t;
-            if (!intersect_plane(clipped, p.point, p.normal, t) || (best.valid() && t >= best.t)) continue;
-            const Hit h = plane_hit(p, t);
-            if ((p.flags & SurfaceFilter::kNeedsAccept) && !m_filter.accept(ray, h, kind)) continue;
-            best = h;
-        }
-        // The backend up to it: geometry in front of (or exactly at) the plane hides it.
-        if (best.valid()) clipped.tfar = best.t;
+        Ray clipped;
+        const Hit best = nearest_plane(ray, kind, clipped);
         const Hit h = m_inner->intersect(clipped, kind);
         return h.valid() ? h : best;
+    }
+
+    /// As intersect() per ray, with the backend's batch query on the clipped rays (in chunks, so
+    /// the scratch lives on the stack).
+    void intersect(std::span<const Ray> rays, RayKind kind, std::span<Hit> hits) const override {
+        RT_CHECK_EQ(rays.size(), hits.size());
+        constexpr size_t kChunk = 64;  // a multiple of every packet width
+        Ray clipped[kChunk];
+        Hit planes[kChunk];
+        for (size_t base = 0; base < rays.size(); base += kChunk) {
+            const size_t n = std::min(kChunk, rays.size() - base);
+            for (size_t i = 0; i < n; ++i) {
+                // Untraceable rays stay so (clipped = ray): the backend's batch misses them too.
+                clipped[i] = rays[base + i];
+                planes[i] = ray_is_traceable(rays[base + i]) ? nearest_plane(rays[base + i], kind, clipped[i]) : Hit{};
+            }
+            m_inner->intersect(std::span<const Ray>(clipped, n), kind, hits.subspan(base, n));
+            for (size_t i = 0; i < n; ++i)
+                if (!hits[base + i].valid()) hits[base + i] = planes[i];
+        }
     }
 
     Color transmittance(const Ray& ray) const override {
@@ -71,7 +85,7 @@ public:
         for (const PlaneData& p : m_planes) {
             float t;
             if (!intersect_plane(ray, p.point, p.normal, t)) continue;
-            if (!(p.flags & (SurfaceFilter::kNeedsTransmittance | SurfaceFilter::kNeedsAccept))) return Color(0.f);
+            if (!(p.flags & SurfaceFilter::kNeedsTransmittance)) return Color(0.f);
             tr *= m_filter.transmittance(ray, plane_hit(p, t));
             if (is_black(tr)) return Color(0.f);
         }
@@ -87,6 +101,23 @@ public:
     }
 
 private:
+    /// The nearest accepted plane hit of a traceable ray (lowest index on equal t), and in
+    /// `clipped` the ray the backend is then asked: up to that hit, so that geometry in front of
+    /// (or exactly at) the plane hides it.
+    Hit nearest_plane(const Ray& ray, RayKind kind, Ray& clipped) const {
+        Hit best;
+        clipped = ray;
+        for (const PlaneData& p : m_planes) {
+            float t;
+            if (!intersect_plane(clipped, p.point, p.normal, t) || (best.valid() && t >= best.t)) continue;
+            const Hit h = plane_hit(p, t);
+            if ((p.flags & SurfaceFilter::kNeedsAccept) && !m_filter.accept(ray, h, kind)) continue;
+            best = h;
+        }
+        if (best.valid()) clipped.tfar = best.t;
+        return best;
+    }
+
     struct PlaneData {
         Vec3d point, normal;
         uint32_t geom;

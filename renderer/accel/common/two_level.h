@@ -63,6 +63,7 @@ struct Affine {
 template <typename T, typename Blas, typename SphereBlas>
 class TwoLevelAccelerator final : public Accelerator {
 public:
+    using Accelerator::intersect;  // the batch query: the default loop (no packet traversal here)
     using BlasBuilder = std::function<Blas(const Mesh&)>;
     using SphereBuilder = std::function<SphereBlas(SpherePrims<T>&&)>;
 
@@ -71,7 +72,7 @@ public:
     /// all instances (the brute-force oracle).
     TwoLevelAccelerator(std::string name, const Scene& scene, const SurfaceFilter& filter, const BlasBuilder& build_blas,
                         const SphereBuilder& build_spheres, bool bvh_top)
-        : m_name(std::move(name)), m_filter(filter), m_bvh_top(bvh_top) {
+        : m_name(std::move(name)), m_scene(scene), m_filter(filter), m_bvh_top(bvh_top) {
         const auto start = std::chrono::steady_clock::now();
         // Spheres: world space, each with its own geometry id and filter flags.
         SpherePrims<T> spheres(scene, filter);
@@ -133,7 +134,7 @@ public:
         thread_local std::vector<Crossing> scratch;
         ShadowQuery<T> q(m_filter, ray, scratch);
         trace(ray, q);
-        return q.resolve();
+        return q.resolve([&](const Crossing& c) { return world_cosine(c, ray); });
     }
 
     std::string name() const override { return m_name; }
@@ -146,6 +147,18 @@ private:
         uint32_t inst;
         uint32_t flags;
     };
+
+    /// crossing_cosine() of a triangle crossing in world space (its vertices through the
+    /// instance transform, in double); 1 for spheres, whose two roots are told apart by `part`.
+    float world_cosine(const Crossing& c, const Ray& ray) const {
+        if (c.inst == kInvalidId) return 1.f;
+        const Instance& inst = m_scene.instances[c.inst];
+        const Mesh& mesh = m_scene.meshes[inst.mesh];
+        Vec3d p[3];
+        for (int k = 0; k < 3; ++k)
+            p[k] = inst.world_from_object.apply_point(Vec3d(mesh.positions[mesh.indices[3 * size_t(c.prim) + size_t(k)]]));
+        return crossing_cosine(cross(p[1] - p[0], p[2] - p[0]), Vec3d(ray.dir));
+    }
 
     /// World box of an object box under a transform (corners in double, rounded outwards).
     static Bounds3<T> world_box(const Bounds3<T>& object, const Mat4d& world_from_object) {
@@ -196,6 +209,7 @@ private:
     }
 
     std::string m_name;
+    const Scene& m_scene;  ///< outlives the accelerator (accelerator.h): triangles of crossings
     const SurfaceFilter& m_filter;
     bool m_bvh_top = true;
     std::vector<std::unique_ptr<Blas>> m_blas;

@@ -2,11 +2,13 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstring>
 #include <cmath>
 #include <mutex>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -29,9 +31,12 @@ std::atomic<int64_t> g_memory_used{0};
 /// rtcSetDeviceMemoryMonitorFunction callback: refusing an allocation (returning false) makes
 /// Embree fail the build with RTC_ERROR_OUT_OF_MEMORY, reported through the error callback as
 /// a whitted::Error instead of the process being killed. Frees (bytes < 0) always pass.
-bool memory_monitor(void*, ssize_t bytes, bool post) {
+/// `device_bytes` (an std::atomic<int64_t>) counts what this one device holds: AccelStats::bytes.
+bool memory_monitor(void* device_bytes, ssize_t bytes, bool post) {
+    auto& device = *static_cast<std::atomic<int64_t>*>(device_bytes);
     if (bytes <= 0) {
         g_memory_used.fetch_add(int64_t(bytes));
+        device.fetch_add(int64_t(bytes));
         return true;
     }
     const int64_t now = g_memory_used.fetch_add(int64_t(bytes)) + int64_t(bytes);
@@ -39,6 +44,7 @@ bool memory_monitor(void*, ssize_t bytes, bool post) {
         g_memory_used.fetch_sub(int64_t(bytes));  // refused: Embree does not report it freed
         return false;
     }
+    device.fetch_add(int64_t(bytes));
     return true;
 }
 
@@ -52,13 +58,15 @@ constexpr size_t kVertexPadding = 16;
 /// crossings de-duplication stops (the product is still taken; documented limit).
 constexpr int kMaxSeen = 64;
 
-// Two candidate hits of one (mesh, instance) closer than kDedupUlps (queries.h, shared with the
-// in-house backends) ulps of t are one crossing: Embree may report a primitive twice (spatial
-// splits) and both triangles at a shared edge.
+// Two candidate hits of one (mesh, instance) within the window of same_crossing() (queries.h,
+// shared with the in-house backends: kDedupUlps ulps of t, wider at grazing incidence) are one
+// crossing: Embree may report a primitive twice (spatial splits) and both triangles at a shared
+// edge.
 
 struct SeenCrossing {
     uint32_t geom, inst;
     float t;
+    float cosine;  ///< crossing_cosine() (1 for spheres)
     uint8_t part;  ///< which root of a sphere (0 for triangles)
 };
 
@@ -68,7 +76,10 @@ struct QueryContext {
     RTCIntersectContext rtc;
     const SurfaceFilter* filter = nullptr;
     const std::vector<uint32_t>* mesh_of_instance = nullptr;
-    const Ray* ray = nullptr;           ///< the world-space ray as the caller gave it
+    /// The world-space rays as the caller gave them: one for a single-ray query, a packet's for a
+    /// batch. Callbacks find a lane's ray by the RTCRay id (its index here), which Embree keeps
+    /// even where it reorders the rays of a packet.
+    const Ray* rays = nullptr;
     RayKind kind = RayKind::Camera;
     Color transmittance{1.f};
     int seen_count = 0;
@@ -91,22 +102,22 @@ void intersect_filter(const RTCFilterFunctionNArguments* args) {
     const auto& q = *reinterpret_cast<const QueryContext*>(args->context);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
-        Hit h = hit_from_filter_args(args, i, q);
-        if (!q.filter->accept(*q.ray, h, q.kind)) args->valid[i] = 0;
+        const Hit h = hit_from_filter_args(args, i, q);
+        if (!q.filter->accept(q.rays[RTCRayN_id(args->ray, args->N, i)], h, q.kind)) args->valid[i] = 0;
     }
 }
 
-/// One candidate crossing of a shadow ray, in traversal order: multiplies its transmittance
-/// unless the same surface was already counted (per (geom, inst, part) within kDedupUlps of t).
-/// Returns true once nothing passes any more (the ray is blocked).
-bool add_crossing(QueryContext& q, const Hit& h, uint8_t part) {
-    const float window = kDedupUlps * (std::nextafter(std::fabs(h.t), kInfinity) - std::fabs(h.t));
+/// One candidate crossing of a shadow ray, in traversal order, with crossing_cosine() `cosine`:
+/// multiplies its transmittance unless the same surface was already counted (per (geom, inst,
+/// part) within the same_crossing() window). Returns true once nothing passes any more.
+bool add_crossing(QueryContext& q, const Hit& h, uint8_t part, float cosine) {
     for (int k = 0; k < q.seen_count; ++k) {
         const SeenCrossing& s = q.seen[k];
-        if (s.geom == h.geom && s.inst == h.inst && s.part == part && std::fabs(s.t - h.t) <= window) return false;
+        if (s.geom == h.geom && s.inst == h.inst && s.part == part && same_crossing(s.t, s.cosine, h.t, cosine))
+            return false;
     }
-    const Color tr = q.filter->transmittance(*q.ray, h);
-    if (q.seen_count < kMaxSeen) q.seen[q.seen_count++] = {h.geom, h.inst, h.t, part};
+    const Color tr = q.filter->transmittance(q.rays[0], h);  // shadow queries are single rays
+    if (q.seen_count < kMaxSeen) q.seen[q.seen_count++] = {h.geom, h.inst, h.t, cosine, part};
     q.transmittance *= tr;
     if (!is_black(q.transmittance)) return false;
     q.transmittance = Color(0.f);
@@ -119,8 +130,14 @@ void occluded_filter(const RTCFilterFunctionNArguments* args) {
     auto& q = *reinterpret_cast<QueryContext*>(args->context);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
+        // The incidence, from Embree's geometric normal and the ray as the filter sees it (both
+        // in the instance's object space, where t was computed).
+        const Vec3f ng{RTCHitN_Ng_x(args->hit, args->N, i), RTCHitN_Ng_y(args->hit, args->N, i),
+                       RTCHitN_Ng_z(args->hit, args->N, i)};
+        const Vec3f dir{RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                        RTCRayN_dir_z(args->ray, args->N, i)};
         // Keep the hit (the ray is blocked, traversal stops) only once nothing passes.
-        if (!add_crossing(q, hit_from_filter_args(args, i, q), 0)) args->valid[i] = 0;
+        if (!add_crossing(q, hit_from_filter_args(args, i, q), 0, crossing_cosine(ng, dir))) args->valid[i] = 0;
     }
 }
 
@@ -128,7 +145,7 @@ void occluded_filter(const RTCFilterFunctionNArguments* args) {
 // The scene's spheres as one RTC_GEOMETRY_TYPE_USER geometry in the top-level scene (primitive i
 // = SpherePrims item i). Embree runs no filter functions for user geometry, so the callbacks
 // apply the same rules as the triangle filters above: accept() for kNeedsAccept, and for shadow
-// rays add_crossing() for both roots, or blocked at once for an opaque sphere. The roots come
+// rays add_crossing() for both roots with kNeedsTransmittance, else blocked at once. The roots come
 // from the in-house kernel (sphere_roots<float>), so t is the float `bvh` backend's t.
 
 Hit sphere_hit(const SpherePrims<float>::Item& s, float t) {
@@ -174,7 +191,9 @@ void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
         float& tfar = RTCRayN_tfar(ray, args->N, i);
         for (const float t : roots) {
             if (!(t > tnear && t <= tfar)) continue;
-            if ((s.flags & SurfaceFilter::kNeedsAccept) && !q.filter->accept(*q.ray, sphere_hit(s, t), q.kind)) continue;
+            if ((s.flags & SurfaceFilter::kNeedsAccept) &&
+                !q.filter->accept(q.rays[RTCRayN_id(ray, args->N, i)], sphere_hit(s, t), q.kind))
+                continue;
             tfar = t;
             RTCHitN_u(hit, args->N, i) = 0.f;
             RTCHitN_v(hit, args->N, i) = 0.f;
@@ -194,7 +213,7 @@ void sphere_occluded_fn(const RTCOccludedFunctionNArguments* args) {
     const auto& spheres = *static_cast<const SpherePrims<float>*>(args->geometryUserPtr);
     auto& q = *reinterpret_cast<QueryContext*>(args->context);
     const SpherePrims<float>::Item& s = spheres.item(args->primID);
-    const bool opaque = !(s.flags & (SurfaceFilter::kNeedsTransmittance | SurfaceFilter::kNeedsAccept));
+    const bool opaque = !(s.flags & SurfaceFilter::kNeedsTransmittance);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
         float roots[2];
@@ -204,7 +223,7 @@ void sphere_occluded_fn(const RTCOccludedFunctionNArguments* args) {
         for (uint8_t part = 0; part < 2; ++part) {
             const float t = roots[part];
             if (!(t > tnear && t <= tfar)) continue;
-            if (opaque || add_crossing(q, sphere_hit(s, t), part)) {
+            if (opaque || add_crossing(q, sphere_hit(s, t), part, 1.f)) {
                 tfar = -kInfinity;  // Embree's mark for an occluded ray
                 break;
             }
@@ -212,18 +231,40 @@ void sphere_occluded_fn(const RTCOccludedFunctionNArguments* args) {
     }
 }
 
+/// rtcIntersect4/8/16 and their ray-hit structures by width.
+template <int K>
+struct EmbreePacket;
+template <>
+struct EmbreePacket<4> {
+    using RayHit = RTCRayHit4;
+    static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* rh) { rtcIntersect4(valid, s, c, rh); }
+};
+template <>
+struct EmbreePacket<8> {
+    using RayHit = RTCRayHit8;
+    static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* rh) { rtcIntersect8(valid, s, c, rh); }
+};
+template <>
+struct EmbreePacket<16> {
+    using RayHit = RTCRayHit16;
+    static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* rh) { rtcIntersect16(valid, s, c, rh); }
+};
+
 class EmbreeAccelerator final : public Accelerator {
 public:
+    using Accelerator::intersect;
+
     EmbreeAccelerator(const Scene& scene, const SurfaceFilter& filter, const EmbreeConfig& config)
-        : m_filter(filter) {
+        : m_filter(filter), m_packet_width(config.packet_width) {
         auto start = std::chrono::steady_clock::now();
         std::string device_config = config.threads > 0 ? "threads=" + std::to_string(config.threads) : "";
         m_device = rtcNewDevice(device_config.c_str());
         if (!m_device) throw Error(fmt::format("Embree: cannot create device ({})", int(rtcGetDeviceError(nullptr))));
         rtcSetDeviceErrorFunction(m_device, &EmbreeAccelerator::on_error, this);
-        rtcSetDeviceMemoryMonitorFunction(m_device, &memory_monitor, nullptr);
+        rtcSetDeviceMemoryMonitorFunction(m_device, &memory_monitor, &m_device_bytes);
 
-        const RTCSceneFlags flags = config.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE;
+        const RTCSceneFlags flags = RTCSceneFlags((config.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE) |
+                                                  (config.compact ? RTC_SCENE_FLAG_COMPACT : RTC_SCENE_FLAG_NONE));
 
         // One Embree scene per mesh, geometry ID 0 inside it.
         m_mesh_scenes.assign(scene.meshes.size(), nullptr);
@@ -241,9 +282,12 @@ public:
                                      mesh.positions.size());
             }
             if (vb) rtcReleaseBuffer(vb);  // the geometry holds its own reference
-            auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                       3 * sizeof(uint32_t), mesh.triangle_count()));
-            if (!v || !idx) {
+            // The index buffer is the Scene's own array, shared: Embree reads indices one by one (the
+            // 16-byte-load padding rule is for vertex buffers), and the Scene outlives the
+            // accelerator (accelerator.h). That saves 12 bytes per triangle.
+            rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.indices.data(), 0,
+                                       3 * sizeof(uint32_t), mesh.triangle_count());
+            if (!v) {
                 rtcReleaseGeometry(g);
                 throw_pending("allocating geometry buffers");
                 throw Error("Embree: cannot allocate geometry buffers");
@@ -253,11 +297,11 @@ public:
                 v[3 * i + 1] = mesh.positions[i].y;
                 v[3 * i + 2] = mesh.positions[i].z;
             }
-            std::copy(mesh.indices.begin(), mesh.indices.end(), idx);
             const uint32_t needs = filter.mesh_flags(uint32_t(m));
             if (needs & SurfaceFilter::kNeedsAccept) rtcSetGeometryIntersectFilterFunction(g, &intersect_filter);
-            if (needs & (SurfaceFilter::kNeedsTransmittance | SurfaceFilter::kNeedsAccept))
-                rtcSetGeometryOccludedFilterFunction(g, &occluded_filter);
+            // Shadow rays read kNeedsTransmittance only (accelerator.h): an opaque single-sided
+            // mesh gets a filter-free rtcOccluded.
+            if (needs & SurfaceFilter::kNeedsTransmittance) rtcSetGeometryOccludedFilterFunction(g, &occluded_filter);
             rtcCommitGeometry(g);
             RTCScene s = rtcNewScene(m_device);
             rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_MEDIUM);
@@ -266,7 +310,6 @@ public:
             rtcReleaseGeometry(g);
             rtcCommitScene(s);
             m_mesh_scenes[m] = s;
-            m_bytes += mesh.positions.size() * 12 + mesh.indices.size() * 4;
         }
 
         // The top level: one instance per Instance, geometry ID = instance index.
@@ -302,7 +345,7 @@ public:
             rtcCommitGeometry(g);
             rtcAttachGeometryByID(m_top, g, m_sphere_geom_id);
             rtcReleaseGeometry(g);
-            m_bytes += m_spheres.bytes();
+            m_sphere_bytes = m_spheres.bytes();
         }
         rtcCommitScene(m_top);
         throw_pending("building the scene");
@@ -318,37 +361,30 @@ public:
 
     Hit intersect(const Ray& ray, RayKind kind) const override {
         if (!ray_is_traceable(ray)) return Hit{};  // NaN/zero-direction rays: Embree asserts on them
-        QueryContext q;
-        rtcInitIntersectContext(&q.rtc);
-        q.filter = &m_filter;
-        q.mesh_of_instance = &m_mesh_of_instance;
-        q.ray = &ray;
-        q.kind = kind;
+        QueryContext q = context(&ray, kind);
         RTCRayHit rh;
-        set_rtc_ray(rh.ray, ray);
+        set_rtc_ray(rh.ray, ray);  // id 0: q.rays[0]
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(m_top, &q.rtc, &rh);
-        Hit h;
-        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return h;
-        if (rh.hit.geomID == m_sphere_geom_id) return sphere_hit(m_spheres.item(rh.hit.primID), rh.ray.tfar);
-        h.t = rh.ray.tfar;
-        h.u = rh.hit.u;
-        h.v = rh.hit.v;
-        h.prim = rh.hit.primID;
-        h.inst = rh.hit.instID[0];
-        h.geom = m_mesh_of_instance[h.inst];
-        return h;
+        return to_hit(rh.hit.geomID, rh.hit.instID[0], rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v);
+    }
+
+    /// Packets of m_packet_width consecutive rays (rtcIntersect4/8/16, coherent context); a
+    /// partial last packet and untraceable rays are masked-off lanes.
+    void intersect(std::span<const Ray> rays, RayKind kind, std::span<Hit> hits) const override {
+        RT_CHECK_EQ(rays.size(), hits.size());
+        switch (m_packet_width) {
+            case 4: return intersect_packets<4>(rays, kind, hits);
+            case 8: return intersect_packets<8>(rays, kind, hits);
+            case 16: return intersect_packets<16>(rays, kind, hits);
+            default: Accelerator::intersect(rays, kind, hits);
+        }
     }
 
     Color transmittance(const Ray& ray) const override {
         if (!ray_is_traceable(ray)) return Color(1.f);
-        QueryContext q;
-        rtcInitIntersectContext(&q.rtc);
-        q.filter = &m_filter;
-        q.mesh_of_instance = &m_mesh_of_instance;
-        q.ray = &ray;
-        q.kind = RayKind::Shadow;
+        QueryContext q = context(&ray, RayKind::Shadow);
         RTCRay r;
         set_rtc_ray(r, ray);
         rtcOccluded1(m_top, &q.rtc, &r);
@@ -357,9 +393,66 @@ public:
     }
 
     std::string name() const override { return "embree"; }
-    AccelStats stats() const override { return {m_build_seconds, m_bytes}; }
+    /// bytes: what the device's memory monitor counts once the build is done (BVHs, the padded
+    /// vertex copies, Embree's internal buffers), plus the sphere table; the shared index
+    /// arrays belong to the Scene and are not counted.
+    AccelStats stats() const override {
+        return {m_build_seconds, size_t(std::max<int64_t>(m_device_bytes.load(), 0)) + m_sphere_bytes};
+    }
 
 private:
+    QueryContext context(const Ray* rays, RayKind kind) const {
+        QueryContext q;
+        rtcInitIntersectContext(&q.rtc);
+        q.filter = &m_filter;
+        q.mesh_of_instance = &m_mesh_of_instance;
+        q.rays = rays;
+        q.kind = kind;
+        return q;
+    }
+
+    /// Our hit record from Embree's (one ray or one packet lane).
+    Hit to_hit(unsigned geom_id, unsigned inst_id, unsigned prim_id, float t, float u, float v) const {
+        Hit h;
+        if (geom_id == RTC_INVALID_GEOMETRY_ID) return h;
+        if (geom_id == m_sphere_geom_id) return sphere_hit(m_spheres.item(prim_id), t);
+        h.t = t;
+        h.u = u;
+        h.v = v;
+        h.prim = prim_id;
+        h.inst = inst_id;
+        h.geom = m_mesh_of_instance[h.inst];
+        return h;
+    }
+
+    template <int K>
+    void intersect_packets(std::span<const Ray> rays, RayKind kind, std::span<Hit> hits) const {
+        using Packet = typename EmbreePacket<K>::RayHit;
+        for (size_t base = 0; base < rays.size(); base += K) {
+            const size_t n = std::min(rays.size() - base, size_t(K));
+            QueryContext q = context(rays.data() + base, kind);
+            q.rtc.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+            alignas(64) int valid[K];
+            Packet rh;
+            const Ray off{Vec3f(0.f), Vec3f(0.f, 0.f, 1.f), 0.f, 0.f};  // masked-off lanes
+            bool any = false;
+            for (int i = 0; i < K; ++i) {
+                // Masked-off lanes still get a finite ray: Embree loads whole packets.
+                const bool on = size_t(i) < n && ray_is_traceable(rays[base + size_t(i)]);
+                valid[i] = on ? -1 : 0;
+                any |= on;
+                set_rtc_lane(rh.ray, i, on ? rays[base + size_t(i)] : off);
+                rh.ray.id[i] = unsigned(i);  // the index in q.rays, for the callbacks
+                rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+                rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+            }
+            if (any) EmbreePacket<K>::intersect(valid, m_top, &q.rtc, &rh);
+            for (size_t i = 0; i < n; ++i)
+                hits[base + i] = valid[i] ? to_hit(rh.hit.geomID[i], rh.hit.instID[0][i], rh.hit.primID[i],
+                                                   rh.ray.tfar[i], rh.hit.u[i], rh.hit.v[i])
+                                          : Hit{};
+        }
+    }
 
     static void on_error(void* user, RTCError code, const char* message) {
         auto* self = static_cast<EmbreeAccelerator*>(user);
@@ -386,7 +479,9 @@ private:
     std::mutex m_error_mutex;
     std::string m_error;
     double m_build_seconds = 0.0;
-    size_t m_bytes = 0;
+    std::atomic<int64_t> m_device_bytes{0};  ///< the memory monitor's count for m_device
+    size_t m_sphere_bytes = 0;               ///< SpherePrims, ours (user data)
+    int m_packet_width = 16;  ///< EmbreeConfig::packet_width
 };
 
 }  // namespace

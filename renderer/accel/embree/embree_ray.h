@@ -24,4 +24,21 @@ inline void set_rtc_ray(RTCRay& r, const Ray& ray) {
     r.flags = 0;
 }
 
+/// Fills lane `i` of an RTCRay4/8/16 packet as set_rtc_ray does (the caller sets the id).
+template <class RTCRayK>
+inline void set_rtc_lane(RTCRayK& r, int i, const Ray& ray) {
+    r.org_x[i] = ray.org.x;
+    r.org_y[i] = ray.org.y;
+    r.org_z[i] = ray.org.z;
+    r.dir_x[i] = ray.dir.x;
+    r.dir_y[i] = ray.dir.y;
+    r.dir_z[i] = ray.dir.z;
+    r.tnear[i] = ray.tnear;
+    r.tfar[i] = ray.tfar;
+    r.time[i] = 0.f;
+    r.mask[i] = 0xffffffffu;
+    r.id[i] = 0;
+    r.flags[i] = 0;
+}
+
 }  // namespace whitted

@@ -1,0 +1,413 @@
+// The query contract of accelerator.h, on every backend:
+//   - shadow queries read only kNeedsTransmittance: a geometry with kNeedsAccept alone is opaque
+//     to shadow rays and its filter is never called for them;
+//   - batch closest-hit queries equal the single-ray query of the same backend (the tie rule is
+//     stated at kBatchRelTol);
+//   - two triangles reporting one transparent crossing at grazing incidence count it once.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "renderer/accel/accelerator.h"
+#include "renderer/core/error.h"
+#include "tests/unit/test_accel_util.h"
+
+namespace whitted {
+namespace {
+
+using namespace whitted::test;
+
+void add_sphere(Scene& s, Vec3d c, double r) { s.spheres.push_back({c, r, 0, "s" + std::to_string(s.spheres.size())}); }
+void add_plane(Scene& s, Vec3d p, Vec3d n, Vec3d u) { s.planes.push_back({p, n, u, 0, "p" + std::to_string(s.planes.size())}); }
+
+/// Every geometry single-sided and opaque (kNeedsAccept alone). accept() rejects everything a
+/// shadow ray would show it and transmittance() lets everything through, so a backend that
+/// consulted either on a shadow ray would return a non-zero transmittance; both count the calls
+/// shadow rays make.
+class SingleSidedOpaque final : public SurfaceFilter {
+public:
+    bool accept(const Ray&, const Hit&, RayKind kind) const override {
+        if (kind == RayKind::Shadow) ++shadow_accepts;
+        return kind != RayKind::Shadow;
+    }
+    Color transmittance(const Ray&, const Hit&) const override {
+        ++transmittance_calls;
+        return Color(1.f);
+    }
+    uint32_t mesh_flags(uint32_t) const override { return kNeedsAccept; }
+
+    mutable std::atomic<int> shadow_accepts{0}, transmittance_calls{0};
+};
+
+/// Meshes (two instances of one, one mirrored), spheres and planes.
+Scene contract_scene() {
+    Scene s;
+    add_mesh_instance(s, make_uv_sphere({0, 0, 0}, 1.f, 12, 16));
+    add_instance(s, 0, Mat4d::translate({0, 3, 0}) * Mat4d::scale({-1, 1, 1}));
+    add_mesh_instance(s, make_terrain(10, 0.2f), Mat4d::translate({0, 0, -2}));
+    add_sphere(s, {3, 0, 0}, 0.8);
+    add_plane(s, {0, 0, 4}, {0, 0, -1}, {1, 0, 0});
+    return s;
+}
+
+TEST(AccelShadowContract, AcceptAloneIsOpaqueToShadowRays) {
+    const Scene s = contract_scene();
+    SingleSidedOpaque filter;
+    // Segments from far outside through each kind of geometry, and one that misses everything.
+    struct Case {
+        Vec3f org, dir;
+        float tfar;
+        bool blocked;
+    };
+    const Case cases[] = {
+        {{0, 0, -1.5f}, {0, 0, 1}, 1.f, true},     // through the mesh sphere's bottom
+        {{0, 0, 0}, {1, 0, 0}, 10.f, true},        // from inside the mesh sphere: its back face
+        {{0, 3, 0}, {0, 0, 1}, 3.f, true},         // inside the mirrored instance, out its top
+        {{0.3f, 0.2f, -5}, {0, 0, 1}, 4.f, true},  // up through the terrain
+        {{3, 0, -5}, {0, 0, 1}, 5.f, true},        // through the analytic sphere
+        {{8, 8, 0}, {0, 0, 1}, 10.f, true},        // through the plane (from its back)
+        {{8, 8, 0}, {0, 0, 1}, 3.f, false},        // stops short of the plane
+    };
+    for (const std::string& name : accelerator_names()) {
+        SCOPED_TRACE(name);
+        const auto accel = create_accelerator(name, s, filter);
+        filter.shadow_accepts = 0;
+        filter.transmittance_calls = 0;
+        for (const Case& c : cases) {
+            Ray r;
+            r.org = c.org;
+            r.dir = c.dir;
+            r.tfar = c.tfar;
+            const Color tr = accel->transmittance(r);
+            EXPECT_EQ(tr.x, c.blocked ? 0.f : 1.f) << "org (" << c.org.x << ", " << c.org.y << ", " << c.org.z << ")";
+            // The closest-hit query does see the geometry (accept() is true for camera rays).
+            r.tfar = kInfinity;
+            EXPECT_TRUE(accel->intersect(r, RayKind::Camera).valid());
+        }
+        EXPECT_EQ(filter.shadow_accepts.load(), 0);
+        EXPECT_EQ(filter.transmittance_calls.load(), 0);
+    }
+}
+
+// ---- batch closest-hit queries against the single-ray query of the same backend ----
+
+/// MixedFilter (cut-outs on meshes, spheres and planes) plus camera-ray back-face culling of
+/// meshes 0 and 3, as SceneView does for single-sided glTF materials. The culling and the sphere
+/// and plane filters depend on the ray passed to accept(), so a batch that handed a callback
+/// another lane's ray would disagree with the single-ray query.
+class CullingFilter final : public SurfaceFilter {
+public:
+    explicit CullingFilter(const Scene& s) : m_scene(s), m_mixed(s) {}
+    bool accept(const Ray& r, const Hit& h, RayKind k) const override {
+        if (!m_mixed.accept(r, h, k)) return false;
+        if (k != RayKind::Camera || !culled(h.geom)) return true;
+        Vec3d p[3];
+        world_triangle(m_scene, h.inst, h.prim, p);
+        return dot(cross(p[1] - p[0], p[2] - p[0]), Vec3d(r.dir)) <= 0.0;
+    }
+    Color transmittance(const Ray& r, const Hit& h) const override { return m_mixed.transmittance(r, h); }
+    uint32_t mesh_flags(uint32_t g) const override { return m_mixed.mesh_flags(g) | (culled(g) ? kNeedsAccept : 0u); }
+
+private:
+    bool culled(uint32_t g) const { return g < m_scene.meshes.size() && (g == 0 || g == 3); }
+    const Scene& m_scene;
+    MixedFilter m_mixed;
+};
+
+/// Meshes with instances (rotated, non-uniformly scaled, mirrored): mesh 0 culled and opaque,
+/// 1 a cut-out soup, 2 transparent terrain, 3 a culled, cut-out, mirrored sphere.
+Scene batch_mesh_scene() {
+    Scene s;
+    add_mesh_instance(s, make_uv_sphere({0, 0, 0}, 1.f, 16, 24));
+    add_mesh_instance(s, make_soup(800, 11, 2.f, 0.15f));
+    add_mesh_instance(s, make_terrain(16, 0.3f), Mat4d::translate({0, 0, -1.5}));
+    add_instance(s, 0, Mat4d::translate({2.5, 0.5, 0}) * Mat4d::rotate(0.2, 0.4, 0.1, 0.888819) * Mat4d::scale({1, 0.5, 2}));
+    add_mesh_instance(s, make_uv_sphere({0, 0, 0}, 0.5f, 6, 8), Mat4d::translate({-2.5, 0, 0}) * Mat4d::scale({-1, 1, 1}));
+    return s;
+}
+
+/// The mesh scene plus spheres of every MixedFilter kind (opaque, transparent, cut away,
+/// entering side cut away; some inside meshes or each other) and three planes (opaque,
+/// transparent, checker cut-out).
+Scene batch_analytic_scene() {
+    Scene s = batch_mesh_scene();
+    const std::pair<Vec3d, double> spheres[] = {{{1.2, 0.4, 0.2}, 0.8}, {{-2, 1, 0}, 1.0}, {{-2, 1, 0}, 0.5},
+                                                {{-2.2, 1.1, 0.1}, 0.2}, {{0, -2, 0}, 0.7}, {{0.5, -2, 0.2}, 0.6},
+                                                {{0.3, 0.2, -1.4}, 0.4}, {{2, -2, 1}, 1e-3}};
+    for (const auto& [c, r] : spheres) add_sphere(s, c, r);
+    add_plane(s, {0, -3, 0}, {0, 1, 0}, {1, 0, 0});
+    const Vec3d n = normalize(Vec3d(1, 2, 3));
+    add_plane(s, {0, 0, 0.5}, n, normalize(cross(n, Vec3d(0, 0, 1))));
+    add_plane(s, {2.8, 0, 0}, {-1, 0, 0}, {0, 0, 1});
+    return s;
+}
+
+/// Random and edge-case rays (test_accel_util.h: through vertices and edge midpoints, axis-
+/// parallel with +-0 components, origins on surfaces, sphere and plane cases), each traceable ray
+/// followed by its tnear/tfar limits as seen by `single`: tfar exactly at its hit, tfar one float
+/// below it, tnear exactly at it; and untraceable rays (NaN, zero direction, tnear > tfar, infinite
+/// tnear) interleaved so that they land in every lane position of a packet.
+std::vector<Ray> batch_rays(const Scene& s, const Accelerator& single, RayKind kind) {
+    std::vector<Ray> base = make_rays(s, 300, 77);
+    const std::vector<Ray> analytic = make_analytic_rays(s, 3, 78);
+    base.insert(base.end(), analytic.begin(), analytic.end());
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::vector<Ray> bad(5);
+    bad[0].dir = {nan, 1, 0};
+    bad[1].dir = {0, 0, 0};
+    bad[2].org = {nan, 0, 0};
+    bad[2].dir = {0, 0, 1};
+    bad[3].dir = {0, 0, 1};
+    bad[3].tnear = 2.f;
+    bad[3].tfar = 1.f;
+    bad[4].dir = {1, 0, 0};
+    bad[4].tnear = kInfinity;
+    std::vector<Ray> rays;
+    for (size_t i = 0; i < base.size(); ++i) {
+        const Ray& r = base[i];
+        rays.push_back(r);
+        const Hit h = single.intersect(r, kind);
+        if (h.valid()) {
+            Ray at = r;
+            at.tfar = h.t;
+            rays.push_back(at);
+            at.tfar = std::nextafter(h.t, -kInfinity);
+            if (at.tfar >= at.tnear) rays.push_back(at);
+            at.tfar = kInfinity;
+            at.tnear = h.t;
+            rays.push_back(at);
+        }
+        if (i % 7 == 3) rays.push_back(bad[(i / 7) % bad.size()]);
+    }
+    return rays;
+}
+
+/// Tolerance of the tie rule: Embree's packet kernels evaluate the same triangle test as its
+/// single-ray kernel with other instruction sequences, so t may differ in the last bits. A batch
+/// answer that is not identical to the single-ray one is accepted as a tie when
+///   - both name a primitive at the same t within this relative tolerance (shared edges and
+///     vertices, where either triangle is right), or
+///   - one side missed and the other hit within the tolerance of the ray's tnear or tfar (the
+///     rays made with tfar exactly at a hit), and the side that missed finds that hit, within the
+///     tolerance, once [tnear, tfar] is widened by it.
+/// Embree's kernels are not watertight (docs/numerical-stability.md): a ray through an edge or a
+/// vertex may fall through the crack in one kernel and not in the other. Such a "crack" (one side
+/// hits a triangle with a barycentric coordinate within kCrackBary of 0, the other passes it and
+/// reports something farther or nothing) is counted apart and bounded for packet widths > 1.
+/// The default batch (in-house backends, and embree:packet=1) must agree exactly.
+constexpr float kBatchRelTol = 1e-6f;
+constexpr float kCrackBary = 1e-4f;
+
+/// The crack case above (`meshes`: geometry ids below it are triangles).
+bool edge_crack(const Hit& batch, const Hit& single, uint32_t meshes) {
+    const bool batch_nearer = batch.valid() && (!single.valid() || batch.t < single.t);
+    const Hit& h = batch_nearer ? batch : single;
+    if (!h.valid() || h.geom >= meshes) return false;
+    return std::min({h.u, h.v, 1.f - h.u - h.v}) <= kCrackBary;
+}
+
+/// The boundary case of the tie rule above.
+bool boundary_tie(const Accelerator& accel, const Ray& ray, RayKind kind, const Hit& batch, const Hit& single) {
+    if (batch.valid() == single.valid()) return false;
+    const Hit& found = batch.valid() ? batch : single;
+    const auto near = [](float a, float b) { return std::fabs(a - b) <= kBatchRelTol * std::max(std::fabs(a), std::fabs(b)); };
+    if (!near(found.t, ray.tnear) && !near(found.t, ray.tfar)) return false;
+    Ray wide = ray;
+    wide.tnear = std::min(ray.tnear, found.t - kBatchRelTol * std::fabs(found.t));
+    wide.tfar = std::max(ray.tfar, found.t + kBatchRelTol * std::fabs(found.t));
+    Hit again;
+    if (batch.valid()) {
+        again = accel.intersect(wide, kind);
+    } else {
+        accel.intersect(std::span<const Ray>(&wide, 1), kind, std::span<Hit>(&again, 1));
+    }
+    return again.valid() && near(again.t, found.t);
+}
+
+struct BatchResult {
+    size_t rays = 0, exact = 0, ties = 0, cracks = 0, differ = 0;
+};
+
+/// Every ray of `rays` through the batch query in consecutive batches of `size` rays (the last
+/// one partial), compared with the single-ray query.
+BatchResult compare_batches(const Accelerator& accel, const std::vector<Ray>& rays, RayKind kind, size_t size,
+                            uint32_t meshes) {
+    BatchResult r;
+    std::vector<Hit> hits(rays.size());
+    for (size_t b = 0; b < rays.size(); b += size) {
+        const size_t n = std::min(size, rays.size() - b);
+        accel.intersect(std::span<const Ray>(rays.data() + b, n), kind, std::span<Hit>(hits.data() + b, n));
+    }
+    for (size_t i = 0; i < rays.size(); ++i) {
+        const Hit single = accel.intersect(rays[i], kind);
+        const Hit& h = hits[i];
+        ++r.rays;
+        const bool identical = h.valid() == single.valid() && h.t == single.t && h.u == single.u && h.v == single.v &&
+                               h.prim == single.prim && h.geom == single.geom && h.inst == single.inst;
+        if (identical) {
+            ++r.exact;
+            continue;
+        }
+        Agreement a = compare_hits(h, single, kBatchRelTol);
+        if (a == Agreement::Differ && boundary_tie(accel, rays[i], kind, h, single)) a = Agreement::Tie;
+        r.ties += a != Agreement::Differ;
+        if (a != Agreement::Differ) continue;
+        const bool crack = edge_crack(h, single, meshes);
+        r.cracks += crack;
+        r.differ += !crack;
+        if (r.cracks + r.differ <= 3)
+            std::printf("  %s (batch %zu, ray %zu): batch t %.9g geom %u inst %u prim %u u %.3g v %.3g, single t %.9g "
+                        "geom %u inst %u prim %u u %.3g v %.3g\n", crack ? "crack" : "differ", size, i, h.t, h.geom,
+                        h.inst, h.prim, h.u, h.v, single.t, single.geom, single.inst, single.prim, single.u, single.v);
+    }
+    return r;
+}
+
+std::vector<std::string> batch_backends() {
+    std::vector<std::string> names = accelerator_names();  // "embree" traces 16-wide packets
+    for (const char* n : {"embree:packet=1", "embree:packet=4", "embree:packet=8", "embree:compact=1"}) names.push_back(n);
+    return names;
+}
+
+void check_batches(const Scene& s, const char* label) {
+    const CullingFilter filter(s);
+    for (const std::string& name : batch_backends()) {
+        const auto accel = create_accelerator(name, s, filter);
+        const bool loops = name.find("embree") == std::string::npos || name == "embree:packet=1";
+        for (const RayKind kind : {RayKind::Camera, RayKind::Reflection}) {
+            SCOPED_TRACE(name + (kind == RayKind::Camera ? " camera" : " reflection"));
+            const std::vector<Ray> rays = batch_rays(s, *accel, kind);
+            BatchResult total;
+            std::vector<size_t> sizes;
+            for (size_t n = 1; n <= 17; ++n) sizes.push_back(n);
+            sizes.push_back(rays.size());  // one batch of everything
+            for (const size_t n : sizes) {
+                const BatchResult r = compare_batches(*accel, rays, kind, n, uint32_t(s.meshes.size()));
+                total.rays += r.rays;
+                total.exact += r.exact;
+                total.ties += r.ties;
+                total.cracks += r.cracks;
+                total.differ += r.differ;
+            }
+            std::printf("[ %s ] %-16s %-10s %zu rays in batches of 1..17 and all: %zu identical, %zu ties, %zu cracks, "
+                        "%zu differ\n", label, name.c_str(), kind == RayKind::Camera ? "camera" : "reflection",
+                        total.rays, total.exact, total.ties, total.cracks, total.differ);
+            EXPECT_EQ(total.differ, 0u);
+            EXPECT_LE(double(total.cracks), 1e-4 * double(total.rays));
+            if (loops) {
+                EXPECT_EQ(total.exact, total.rays);
+            }
+        }
+    }
+}
+
+TEST(AccelBatch, MeshesWithInstancesCutOutsAndCulling) { check_batches(batch_mesh_scene(), "meshes"); }
+
+TEST(AccelBatch, SpheresAndPlanesToo) { check_batches(batch_analytic_scene(), "analytic"); }
+
+/// Embree's stats report what its memory monitor counted: the BVHs and the padded vertex copies
+/// (the index arrays are shared with the Scene), less with RTC_SCENE_FLAG_COMPACT.
+TEST(AccelEmbreeStats, BytesAreTheMemoryMonitorsCount) {
+    const Scene s = batch_mesh_scene();
+    const CullingFilter filter(s);
+    const size_t triangles = s.instanced_triangle_count();
+    const size_t plain = create_accelerator("embree", s, filter)->stats().bytes;
+    const size_t compact = create_accelerator("embree:compact=1", s, filter)->stats().bytes;
+    std::printf("[ embree bytes ] %zu triangles: %zu bytes (%.1f B/triangle), compact %zu (%.1f B/triangle)\n", triangles,
+                plain, double(plain) / double(triangles), compact, double(compact) / double(triangles));
+    // More than the vertex copies alone (12 B per vertex), i.e. the BVH is counted.
+    size_t vertex_bytes = 0;
+    for (const Mesh& m : s.meshes) vertex_bytes += m.positions.size() * 12;
+    EXPECT_GT(plain, vertex_bytes + 16 * triangles);
+    EXPECT_LT(compact, plain);
+    EXPECT_THROW((void)create_accelerator("embree:compact=2", s, filter), Error);
+}
+
+TEST(AccelBatch, EmptyBatchAndSizeMismatch) {
+    const Scene s = batch_analytic_scene();
+    const CullingFilter filter(s);
+    for (const std::string& name : batch_backends()) {
+        SCOPED_TRACE(name);
+        const auto accel = create_accelerator(name, s, filter);
+        std::vector<Ray> rays(3);
+        for (Ray& r : rays) r.dir = {0, 0, 1};
+        std::vector<Hit> hits(2);
+        accel->intersect(std::span<const Ray>(), RayKind::Camera, std::span<Hit>());
+        EXPECT_THROW(accel->intersect(std::span<const Ray>(rays), RayKind::Camera, std::span<Hit>(hits)), Error);
+    }
+    EXPECT_THROW((void)create_accelerator("embree:packet=2", s, filter), Error);
+}
+
+// ---- transparent crossings at a shared edge seen at grazing incidence ----
+
+/// Every geometry transparent, Kt 0.5: a shadow ray's transmittance is 0.5^crossings.
+class HalfTransparent final : public SurfaceFilter {
+public:
+    bool accept(const Ray&, const Hit&, RayKind) const override { return true; }
+    Color transmittance(const Ray&, const Hit&) const override { return Color(0.5f); }
+    uint32_t mesh_flags(uint32_t) const override { return kNeedsTransmittance; }
+};
+
+/// One surface whose crossing two triangles of its mesh report with differently rounded t, seen
+/// at grazing incidence: a tilted planar quad triangulated twice (split along either diagonal,
+/// coincident coplanar faces, as at a shared edge every point of the quad lies on two triangles),
+/// crossed at cos 1e-1 ... 1e-4 to its plane. Each triangle's t carries an error that grows as
+/// 1/|cos| (its projection onto the plane normal to the ray is thin); at small cos the two t
+/// differ by more than kDedupUlps ulps. The crossing must count once (docs/numerical-stability.md,
+/// open point 6): Kt = 0.5 exactly. The quad is instanced twice (identity, and scaled by 2 and
+/// moved), so the window scaling is exercised in object space too.
+TEST(AccelShadowDedup, OneSurfaceTwoTrianglesAtGrazingIncidenceCountsOnce) {
+    Scene s;
+    Mesh quad;
+    const Vec3d e1 = normalize(Vec3d(0.8, 0.3, -0.2)), n = normalize(cross(e1, Vec3d(0.1, 1.0, 0.4)));
+    const Vec3d e2 = cross(n, e1), c0(0.37, -0.21, 0.13);
+    for (const auto& [a, b] : {std::pair{-1.0, -1.0}, {1.0, -1.0}, {1.0, 1.0}, {-1.0, 1.0}})
+        quad.positions.push_back(Vec3f(c0 + e1 * (1.3 * a) + e2 * (0.9 * b)));
+    quad.indices = {0, 1, 2, 0, 2, 3, 0, 1, 3, 1, 2, 3};  // split along 0-2, and again along 1-3
+    quad.normals.assign(4, Vec3f(n));
+    add_mesh_instance(s, quad);
+    const Mat4d second = Mat4d::translate({0.5, -4, 3}) * Mat4d::scale({2, 2, 2});
+    add_instance(s, 0, second);
+    const HalfTransparent filter;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    for (const std::string& name : accelerator_names()) {
+        SCOPED_TRACE(name);
+        const auto accel = create_accelerator(name, s, filter);
+        size_t rays = 0, once = 0, twice = 0, other = 0;
+        for (int i = 0; i < 20000; ++i) {
+            // A point inside the quad, and a direction at cos 1e-1 ... 1e-4 to its plane.
+            const Vec3d target = c0 + e1 * (1.3 * (1.6 * u01(rng) - 0.8)) + e2 * (0.9 * (1.6 * u01(rng) - 0.8));
+            const double az = 6.283185307179586 * u01(rng);
+            const Vec3d across = e1 * std::cos(az) + e2 * std::sin(az);
+            const double cosine = std::pow(10.0, -1.0 - 3.0 * u01(rng));
+            const Vec3d dir = across * std::sqrt(1.0 - cosine * cosine) + n * (u01(rng) < 0.5 ? cosine : -cosine);
+            const Mat4d& xf = i % 2 ? second : Mat4d::identity();
+            Ray r;
+            r.org = Vec3f(xf.apply_point(target - dir));
+            r.dir = Vec3f(xf.apply_vector(dir));
+            r.tfar = 2.f;
+            const float tr = accel->transmittance(r).x;
+            ++rays;
+            once += tr == 0.5f;
+            twice += tr == 0.25f;
+            other += tr != 0.5f && tr != 0.25f;
+        }
+        std::printf("[ grazing edge ] %-8s %zu rays: %zu once, %zu twice, %zu other\n", name.c_str(), rays, once, twice,
+                    other);
+        EXPECT_EQ(twice, 0u);
+        EXPECT_EQ(other, 0u);
+    }
+}
+
+}  // namespace
+}  // namespace whitted
