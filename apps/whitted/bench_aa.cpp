@@ -2,12 +2,16 @@
 //
 // For each scene: a converged box-filtered reference (stratified, --ref-spp samples per pixel,
 // cached on disk by a hash of the scene files and the settings), then every mode over a sweep of
-// settings on the same accelerator. Each run reports wall time (the minimum of --repeat runs),
-// primary and total rays, RMSE / PSNR / relative MSE against the reference in linear and in
-// display-referred values (the OCIO "Standard" view, clamped to [0, 1]) and the fraction of
-// pixels adaptive sampling subdivided. Writes <out>/aa.csv, per scene the reference image and an
-// adaptive sample-density heat map, and (when python3 with matplotlib is available) the
-// error-against-time plots through scripts/plot_aa.py. See docs/antialiasing.md.
+// settings on the same accelerator. Each run reports its time (process CPU time by default, or
+// wall time; the minimum of --repeat runs, interleaved over the sweep so a burst of load on a
+// shared machine does not hit one setting only), primary, total and per-kind ray counts, RMSE /
+// PSNR / relative MSE against the reference in linear and in display-referred values (the OCIO
+// "Standard" view, clamped to [0, 1]) and the fraction of pixels adaptive sampling subdivided.
+// It prints the targets (adaptive against stratified 16 spp, corners against center) with the
+// decomposition of adaptive's cost (camera rays, rays per camera ray, time per ray) and, with
+// --replay, how much of each target run is outside the ray trees. Writes <out>/aa.csv, per scene
+// the reference image and an adaptive sample-density heat map, and (when python3 with matplotlib
+// is available) the error-against-time plots through scripts/plot_aa.py. See docs/antialiasing.md.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -19,10 +23,13 @@
 #include <string>
 #include <vector>
 
+#include "apps/whitted/bench_timing.h"
 #include "apps/whitted/command.h"
+#include "apps/whitted/ray_recording.h"
 #include "importers/scene_loader.h"
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
+#include "renderer/integrator/camera.h"
 #include "renderer/integrator/render.h"
 #include "renderer/output/image_output.h"
 
@@ -41,10 +48,12 @@ struct BenchAaOptions {
     int ref_spp = 256;               ///< reference samples per pixel (k*k, box filter)
     int repeat = 3;                  ///< timed runs per setting (fewer once a setting has taken 2 s); the minimum is reported
     int threads = 0;                 ///< 0 = all cores
-    int max_depth = 5;               ///< ray-tree depth
+    int max_depth = -1;              ///< ray-tree depth; -1 = the scene file's, else 5
+    std::string timing = "cpu";      ///< "cpu": process CPU time (robust on a shared machine; use --threads 1), "wall"
     std::string out = "bench-aa";    ///< output directory (CSV, images, plots)
     std::string cache;               ///< reference cache directory; empty = $XDG_CACHE_HOME/whitted or ~/.cache/whitted
     bool quick = false;              ///< a shorter sweep
+    bool replay = false;             ///< split the target runs' CPU time into ray trees and the rest (needs --threads 1)
     bool plot = true;                ///< run scripts/plot_aa.py afterwards when possible
     std::string python = "python3";  ///< interpreter with matplotlib for the plots
 };
@@ -53,7 +62,11 @@ struct BenchAaOptions {
 struct Run {
     std::string scene;
     AaSettings aa;
-    double seconds = 0.0;
+    double seconds = 0.0;            ///< the reported time: cpu_seconds or wall_seconds (--timing)
+    double cpu_seconds = 1e30;       ///< minimum process CPU time of one render
+    double wall_seconds = 1e30;      ///< minimum wall time of one render
+    double spent = 0.0;              ///< time spent on this setting so far (for the 2 s budget)
+    Film film;                       ///< the last image (every run gives the same one)
     RenderStats stats;
     double rmse_lin = 0, psnr_lin = 0, relmse_lin = 0, rmse_disp = 0, psnr_disp = 0, relmse_disp = 0;
     bool pareto = false;
@@ -184,6 +197,39 @@ std::vector<AaSettings> sweep(bool quick) {
     return s;
 }
 
+/// Where a render's CPU time goes: the time of the render (min of `repeat`) and of tracing the same
+/// camera rays, recorded from it, through the integrator in a plain loop on this thread (the ray
+/// trees alone). The difference is what the sampling mode adds: camera ray generation, the AA
+/// logic (subdivision, shared points), the film.
+struct ReplaySplit {
+    double render_seconds = 1e30, replay_seconds = 1e30;
+};
+
+ReplaySplit replay_split(const Renderer& renderer, const Scene& scene, const RenderSettings& rs, const AaSettings& aa,
+                         int repeat) {
+    const RecordingAccelerator recorder(renderer.accelerator());
+    (void)renderer.render(aa, rs.integrator, recorder);
+    std::vector<Ray> camera_rays;
+    for (const RecordedRay& r : recorder.rays())
+        if (r.kind == RayKind::Camera && !r.shadow) camera_rays.push_back(r.ray);
+    const ImageSize size = renderer.image_size();
+    const RayCone cone = CameraModel(scene.cameras[size_t(rs.camera)], size.width, size.height).pixel_cone();
+    const WhittedIntegrator integrator(renderer.view(), renderer.accelerator(), rs.integrator);
+    ReplaySplit split;
+    for (int i = 0; i < std::max(1, repeat); ++i) {  // interleaved, minimum of each
+        double t0 = process_cpu_seconds();
+        (void)renderer.render(aa);
+        split.render_seconds = std::min(split.render_seconds, process_cpu_seconds() - t0);
+        RayCounters rc;
+        Color sum(0.f);
+        t0 = process_cpu_seconds();
+        for (const Ray& ray : camera_rays) sum += integrator.trace(ray, RayKind::Camera, 0, rc, nullptr, cone);
+        split.replay_seconds = std::min(split.replay_seconds, process_cpu_seconds() - t0);
+        if (!is_finite(sum)) log_debug("bench aa: replay summed to a non-finite value");  // keeps the loop alive
+    }
+    return split;
+}
+
 /// Marks the runs no other run beats in both time and display RMSE.
 void mark_pareto(std::vector<Run>& runs) {
     for (Run& r : runs) {
@@ -201,28 +247,38 @@ int run_bench_aa(const BenchAaOptions& o) {
     fs::create_directories(out);
     const fs::path cache = (o.cache.empty() ? default_cache_dir() : fs::path(o.cache)) / "aa-references";
     fs::create_directories(cache);
+    if (o.timing != "cpu" && o.timing != "wall") throw Error(fmt::format("--timing: expected cpu or wall, got '{}'", o.timing));
+    const bool cpu_time = o.timing == "cpu";
+    if (o.replay && o.threads != 1) throw Error("bench aa: --replay compares process CPU times and needs --threads 1");
     const DisplayTransform display(ColorSettings{});
 
     std::ofstream csv(out / "aa.csv");
     csv << "scene,mode,filter,threshold,depth,spp,label,seconds,camera_rays,total_rays,camera_rays_per_pixel,"
            "rmse_linear,psnr_linear,relmse_linear,rmse_display,psnr_display,relmse_display,subdivided_fraction,"
-           "pareto\n";
+           "pareto,timing,cpu_seconds,wall_seconds,shadow_rays,secondary_rays,threads,load\n";
 
     for (const std::string& scene_path : o.scenes) {
         const std::string label = scene_label(scene_path);
         Scene scene = load_scene(scene_path);
+        // A scene file's settings (ambient, background, ray depth, ...) apply; size and AA are the bench's.
         RenderSettings rs;
+        apply_scene_settings(scene.settings, rs);
         rs.width = o.width;
+        rs.height = 0;
         rs.threads = o.threads;
-        rs.integrator.max_depth = o.max_depth;
+        rs.progress = false;
+        rs.aa = AaSettings{};
+        if (o.max_depth >= 0) rs.integrator.max_depth = o.max_depth;
+        else if (!scene.settings.max_depth) rs.integrator.max_depth = 5;
         Renderer renderer(scene, rs);
         const ImageSize size = renderer.image_size();
-        std::printf("== %s: %dx%d, %zu triangles, build %.3fs\n", label.c_str(), size.width, size.height,
-                    scene.instanced_triangle_count(), renderer.build_seconds());
+        std::printf("== %s: %dx%d, %zu triangles, build %.3fs, ray depth %d, %s time, load %.2f\n", label.c_str(),
+                    size.width, size.height, scene.instanced_triangle_count(), renderer.build_seconds(),
+                    rs.integrator.max_depth, cpu_time ? "process CPU" : "wall", load_average_1min());
 
         // Reference: cached by scene files + settings (+ renderer version tag).
         const std::string key_text = fmt::format("{}|{}|{}x{}|spp={}|box|depth={}|{}", kReferenceVersion, WHITTED_VERSION,
-                                                 size.width, size.height, o.ref_spp, o.max_depth, label);
+                                                 size.width, size.height, o.ref_spp, rs.integrator.max_depth, label);
         const uint64_t key = fnv1a(hash_scene_files(scene_path), key_text.data(), key_text.size());
         const fs::path ref_path = cache / fmt::format("{}-{:016x}.exr", label, key);
         std::vector<float> ref;
@@ -251,27 +307,33 @@ int run_bench_aa(const BenchAaOptions& o) {
         }
         const std::vector<float> ref_disp = to_display(ref, display);
 
+        // Every setting once per round, --repeat rounds: each keeps its minimum time, and a burst of
+        // load on a shared machine spreads over the settings instead of hitting one.
         std::vector<Run> runs;
         for (const AaSettings& aa : sweep(o.quick)) {
             Run r;
             r.scene = label;
             r.aa = aa;
-            r.seconds = 1e30;
-            Film film;
-            double spent = 0.0;
-            for (int i = 0; i < std::max(1, o.repeat) && spent < 2.0; ++i) {
+            runs.push_back(std::move(r));
+        }
+        for (int round = 0; round < std::max(1, o.repeat); ++round)
+            for (Run& r : runs) {
+                if (round > 0 && r.spent >= 2.0) continue;  // slow settings: fewer runs
                 RenderStats st;
-                film = renderer.render(aa, &st);
-                spent += st.render_seconds;
-                if (st.render_seconds < r.seconds) {
-                    r.seconds = st.render_seconds;
-                    r.stats = st;
-                }
+                const double cpu0 = process_cpu_seconds();
+                r.film = renderer.render(r.aa, &st);
+                const double cpu = process_cpu_seconds() - cpu0;
+                r.spent += cpu_time ? cpu : st.render_seconds;
+                r.cpu_seconds = std::min(r.cpu_seconds, cpu);
+                r.wall_seconds = std::min(r.wall_seconds, st.render_seconds);
+                r.stats = st;  // counts and image are the same every run
             }
-            const std::vector<float> img = packed(film);
+        for (Run& r : runs) {
+            r.seconds = cpu_time ? r.cpu_seconds : r.wall_seconds;
+            const std::vector<float> img = packed(r.film);
+            r.film = Film{};
             metrics(img, ref, r.rmse_lin, r.psnr_lin, r.relmse_lin);
             metrics(to_display(img, display), ref_disp, r.rmse_disp, r.psnr_disp, r.relmse_disp);
-            runs.push_back(r);
         }
         mark_pareto(runs);
 
@@ -283,14 +345,17 @@ int run_bench_aa(const BenchAaOptions& o) {
             std::printf("   %-28s %9.4f %10llu %8.2f %10.5f %10.5f %8.2f %5.1f%%%s\n", describe(r.aa).c_str(), r.seconds,
                         (unsigned long long)r.stats.rays.camera, double(r.stats.rays.camera) / pixels, r.rmse_lin,
                         r.rmse_disp, r.psnr_disp, 100.0 * split, r.pareto ? "  *" : "");
-            csv << fmt::format("{},{},{},{:g},{},{},\"{}\",{:.6f},{},{},{:.4f},{:.6g},{:.4f},{:.6g},{:.6g},{:.4f},{:.6g},{:.5f},{}\n",
+            csv << fmt::format("{},{},{},{:g},{},{},\"{}\",{:.6f},{},{},{:.4f},{:.6g},{:.4f},{:.6g},{:.6g},{:.4f},{:.6g},{:.5f},{},"
+                               "{},{:.6f},{:.6f},{},{},{},{:.2f}\n",
                                label, aa_mode_name(r.aa.mode), pixel_filter_name(r.aa.filter),
                                r.aa.mode == AaMode::Adaptive ? r.aa.threshold : 0.f,
                                r.aa.mode == AaMode::Adaptive ? r.aa.depth : 0,
                                r.aa.mode == AaMode::Stratified ? r.aa.spp : (r.aa.mode == AaMode::Center ? 1 : 0),
                                describe(r.aa), r.seconds, r.stats.rays.camera, r.stats.rays.total(),
                                double(r.stats.rays.camera) / pixels, r.rmse_lin, r.psnr_lin, r.relmse_lin, r.rmse_disp,
-                               r.psnr_disp, r.relmse_disp, split, r.pareto ? 1 : 0);
+                               r.psnr_disp, r.relmse_disp, split, r.pareto ? 1 : 0, o.timing, r.cpu_seconds,
+                               r.wall_seconds, r.stats.rays.shadow, r.stats.rays.secondary(), r.stats.threads,
+                               load_average_1min());
         }
         csv.flush();
 
@@ -314,15 +379,32 @@ int run_bench_aa(const BenchAaOptions& o) {
                 if (r.aa.mode == AaMode::Adaptive && r.rmse_disp <= s16->rmse_disp &&
                     (!fewest || r.stats.rays.total() < fewest->stats.rays.total()))
                     fewest = &r;
-            if (best)
-                std::printf("   target adaptive <= 1/3 time of stratified 16 at its display RMSE %.5f: %s at %.3fx time -> %s;"
-                            " by total rays %s at %.3fx\n",
-                            s16->rmse_disp, describe(best->aa).c_str(), best->seconds / s16->seconds,
+            auto rays_ratio = [&](const Run& r) { return double(r.stats.rays.total()) / double(s16->stats.rays.total()); };
+            if (best) {
+                std::printf("   target adaptive <= 1/3 time of stratified 16 at its display RMSE %.5f: %s at %.3fx time "
+                            "(%.3fx total rays) -> %s; fewest rays: %s at %.3fx\n",
+                            s16->rmse_disp, describe(best->aa).c_str(), best->seconds / s16->seconds, rays_ratio(*best),
                             best->seconds <= s16->seconds / 3.0 ? "MET" : "NOT MET", describe(fewest->aa).c_str(),
-                            double(fewest->stats.rays.total()) / double(s16->stats.rays.total()));
-            else
+                            rays_ratio(*fewest));
+                // Why time and rays differ: rays per camera ray (the ray trees' size) and time per ray.
+                auto tree = [](const Run& r) { return double(r.stats.rays.total()) / double(r.stats.rays.camera); };
+                auto per_ray = [](const Run& r) { return 1e9 * r.seconds / double(r.stats.rays.total()); };
+                std::printf("   rays per camera ray: %s %.2f, stratified 16 %.2f; time per ray %.0f ns vs %.0f ns (%.2fx)\n",
+                            describe(best->aa).c_str(), tree(*best), tree(*s16), per_ray(*best), per_ray(*s16),
+                            per_ray(*best) / per_ray(*s16));
+                if (o.replay) {
+                    for (const Run* r : {best, s16}) {
+                        const ReplaySplit split = replay_split(renderer, scene, rs, r->aa, o.repeat);
+                        std::printf("   replay (CPU, 1 thread): %s renders in %.4fs, its camera rays' trees alone take %.4fs:"
+                                    " %.1f%% of the render is outside the ray trees\n",
+                                    describe(r->aa).c_str(), split.render_seconds, split.replay_seconds,
+                                    100.0 * (split.render_seconds - split.replay_seconds) / split.render_seconds);
+                    }
+                }
+            } else {
                 std::printf("   target adaptive <= 1/3 time of stratified 16 at its display RMSE %.5f: no adaptive setting "
                             "reaches it -> NOT MET\n", s16->rmse_disp);
+            }
         }
         if (center && corners)
             std::printf("   target corners <= 1.1x center time: %.3fx -> %s (display RMSE center %.5f, corners %.5f)\n",
@@ -369,10 +451,16 @@ Command register_bench_aa(CLI::App& bench) {
     app->add_option("--repeat", o->repeat, "Timed runs per setting (the minimum is reported)")->check(CLI::Range(1, 100))
         ->capture_default_str();
     app->add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 1024))->capture_default_str();
-    app->add_option("--max-depth", o->max_depth, "Maximum depth of the ray tree")->check(CLI::Range(0, 64))->capture_default_str();
+    app->add_option("--max-depth", o->max_depth, "Maximum depth of the ray tree (-1 = the scene file's, else 5)")
+        ->check(CLI::Range(-1, 64))->capture_default_str();
+    app->add_option("--timing", o->timing, "Time each render by process CPU time (cpu: robust on a shared machine, "
+                    "exact with --threads 1) or wall-clock time (wall)")->check(CLI::IsMember({"cpu", "wall"}))
+        ->capture_default_str();
     app->add_option("--out", o->out, "Output directory: aa.csv, reference/adaptive/heat-map PNGs, plots")->capture_default_str();
     app->add_option("--cache", o->cache, "Reference cache directory (default $XDG_CACHE_HOME/whitted or ~/.cache/whitted)");
     app->add_flag("--quick", o->quick, "A shorter sweep");
+    app->add_flag("--replay", o->replay, "For the target runs, time the render against replaying its camera rays "
+                  "through the integrator in a plain loop (needs --threads 1)");
     app->add_flag("!--no-plot", o->plot, "Do not run scripts/plot_aa.py");
     app->add_option("--python", o->python, "Python interpreter with matplotlib for the plots")->capture_default_str();
     return Command{app, [o] { return run_bench_aa(*o); }};

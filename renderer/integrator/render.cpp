@@ -142,11 +142,12 @@ struct Rect {
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
 };
 
-/// Adaptive samples on pixel edges (not corners), keyed by their position on the 2^depth lattice of
-/// the full image. Each is used by at most the two pixels sharing the edge, possibly in different
-/// tiles: the first request traces it while holding the element's write lock (a concurrent request
-/// for the same point waits instead of tracing it again), the second one removes it, so the map
-/// only holds the points whose second user has not run yet.
+/// Adaptive samples on pixel edges (not corners) that lie on a border between two tiles, keyed by
+/// their position on the 2^depth lattice of the full image. Each is used by at most the two pixels
+/// sharing the edge, in different tiles that may run concurrently: the first request traces it
+/// while holding the element's write lock (a concurrent request for the same point waits instead of
+/// tracing it again), the second one removes it, so the map only holds the points whose second
+/// user has not run yet. Edges inside a tile never come here (see AdaptiveScratch).
 class EdgeSamples {
 public:
     template <typename Trace>
@@ -171,12 +172,22 @@ private:
     Map m_map;
 };
 
-/// Per-thread grid of one pixel's adaptive samples: (2^depth + 1)^2 points; a point is valid when
-/// its stamp equals the current generation, so nothing is cleared between pixels.
+/// Per-thread working memory of the adaptive pass.
+/// - One pixel's grid of (2^depth + 1)^2 points; a point is valid when its stamp equals the current
+///   generation, so nothing is cleared between pixels.
+/// - The edge points a pixel hands to the neighbours it shares an edge with inside the same tile
+///   (pixels run row by row): the n - 1 points inside its right edge, read by the next pixel of the
+///   row, and inside its bottom edge, read by the pixel below (one slot per tile column). A point
+///   the first pixel did not need is marked invalid and the second traces it itself, so tile-inner
+///   edges are shared without hashing or locking; only tile borders go through EdgeSamples.
 struct AdaptiveScratch {
     std::vector<Color> value;
     std::vector<uint32_t> stamp;
     uint32_t generation = 0;
+    std::vector<Color> right;          ///< n - 1 points inside the previous pixel's right edge
+    std::vector<uint8_t> right_valid;
+    std::vector<Color> bottom;         ///< per tile column, n - 1 points inside the bottom edge of the pixel above
+    std::vector<uint8_t> bottom_valid;
 };
 
 /// Everything one render() call shares between its tiles.
@@ -259,10 +270,17 @@ public:
     /// adaptive (Whitted 1980): recursive subdivision of each pixel square from its lattice corners.
     void adaptive_tile(const Rect& r, RayCounters& rc, AdaptiveScratch& scratch) {
         const size_t points = size_t(m_n + 1) * size_t(m_n + 1);
+        const size_t inner = size_t(m_n - 1);  // points inside one pixel edge
         if (scratch.value.size() != points) {
             scratch.value.assign(points, Color(0.f));
             scratch.stamp.assign(points, 0u);
             scratch.generation = 0;
+            scratch.right.assign(inner, Color(0.f));
+            scratch.right_valid.assign(inner, 0);
+        }
+        if (scratch.bottom.size() < size_t(r.x1 - r.x0) * inner) {
+            scratch.bottom.resize(size_t(r.x1 - r.x0) * inner);
+            scratch.bottom_valid.resize(size_t(r.x1 - r.x0) * inner);
         }
         for (int y = r.y0; y < r.y1; ++y)
             for (int x = r.x0; x < r.x1; ++x) {
@@ -270,9 +288,10 @@ public:
                     std::fill(scratch.stamp.begin(), scratch.stamp.end(), 0u);
                     scratch.generation = 1;
                 }
-                PixelRecursion p{x, y, 0, false};
+                PixelRecursion p{x, y, &r, 0, false};
                 const Color c = subdivide(p, scratch, rc, 0, 0, m_n, 0);
                 if (p.split) ++m_subdivided;
+                hand_over_edges(p, scratch);
                 finish_pixel(x, y, c, float(p.points), nullptr, rc);
             }
     }
@@ -282,9 +301,10 @@ public:
 
 private:
     struct PixelRecursion {
-        int x, y;        ///< pixel
-        int points;      ///< distinct sample points used
-        bool split;      ///< the pixel square was split
+        int x, y;           ///< pixel
+        const Rect* tile;   ///< the tile it belongs to
+        int points;         ///< distinct sample points used
+        bool split;         ///< the pixel square was split
     };
 
     size_t lattice_index(int x, int y) const {
@@ -300,18 +320,59 @@ private:
         s.stamp[k] = s.generation;
         ++p.points;
         const int n = m_n;
-        const double inv_n = 1.0 / n;
         const bool on_x = i == 0 || i == n, on_y = j == 0 || j == n;
-        if (on_x && on_y) {
-            s.value[k] = corner(p.x + i / n, p.y + j / n);
-        } else if (on_x || on_y) {
-            // On the pixel's border: shared with the neighbour across that edge.
-            const uint64_t gx = uint64_t(p.x) * uint64_t(n) + uint64_t(i), gy = uint64_t(p.y) * uint64_t(n) + uint64_t(j);
-            s.value[k] = m_edges.get(gx << 32 | gy, [&] { return sample(p.x + i * inv_n, p.y + j * inv_n, rc); });
-        } else {
-            s.value[k] = sample(p.x + i * inv_n, p.y + j * inv_n, rc);
-        }
+        if (on_x && on_y) s.value[k] = corner(p.x + i / n, p.y + j / n);
+        else if (on_x || on_y) s.value[k] = edge_point(p, s, rc, i, j);
+        else s.value[k] = sample(p.x + double(i) / n, p.y + double(j) / n, rc);
         return s.value[k];
+    }
+
+    /// A point inside one of pixel p's edges (i or j is 0 or n, not both). The edge is either on the
+    /// window's border (no neighbour: traced), inside the tile (the left or upper pixel, which ran
+    /// before, handed it over when it had traced it; the right or lower one will take it from us),
+    /// or on a tile border (shared through EdgeSamples with the pixel in the other tile).
+    Color edge_point(PixelRecursion& p, AdaptiveScratch& s, RayCounters& rc, int i, int j) {
+        const int n = m_n;
+        const Rect& r = *p.tile;
+        const PixelWindow& w = m_film.window;
+        auto trace = [&] { return sample(p.x + double(i) / n, p.y + double(j) / n, rc); };
+        // Is the pixel across the edge in this tile, and in the window at all?
+        bool in_tile = false, in_window = false;
+        if (i == 0) {  // left edge: the previous pixel of the row handed it over
+            in_tile = p.x > r.x0;
+            in_window = p.x > w.x0;
+            if (in_tile) return s.right_valid[size_t(j - 1)] ? s.right[size_t(j - 1)] : trace();
+        } else if (j == 0) {  // top edge: the pixel above handed it over
+            in_tile = p.y > r.y0;
+            in_window = p.y > w.y0;
+            const size_t slot = size_t(p.x - r.x0) * size_t(n - 1) + size_t(i - 1);
+            if (in_tile) return s.bottom_valid[slot] ? s.bottom[slot] : trace();
+        } else if (i == n) {  // right edge
+            in_tile = p.x + 1 < r.x1;
+            in_window = p.x + 1 < w.x1;
+        } else {  // bottom edge
+            in_tile = p.y + 1 < r.y1;
+            in_window = p.y + 1 < w.y1;
+        }
+        if (in_tile || !in_window) return trace();  // hand_over_edges() passes it on / nobody else needs it
+        const uint64_t gx = uint64_t(p.x) * uint64_t(n) + uint64_t(i), gy = uint64_t(p.y) * uint64_t(n) + uint64_t(j);
+        return m_edges.get(gx << 32 | gy, trace);
+    }
+
+    /// After pixel p: passes the points inside its right and bottom edges (valid when traced) to
+    /// the pixels that will read them in edge_point().
+    void hand_over_edges(const PixelRecursion& p, AdaptiveScratch& s) const {
+        const int n = m_n;
+        const size_t stride = size_t(n + 1);
+        for (int t = 1; t < n; ++t) {
+            const size_t kr = size_t(t) * stride + size_t(n);    // right edge, (n, t)
+            const size_t kb = size_t(n) * stride + size_t(t);    // bottom edge, (t, n)
+            const size_t slot = size_t(p.x - p.tile->x0) * size_t(n - 1) + size_t(t - 1);
+            s.right_valid[size_t(t - 1)] = s.stamp[kr] == s.generation;
+            s.right[size_t(t - 1)] = s.value[kr];
+            s.bottom_valid[slot] = s.stamp[kb] == s.generation;
+            s.bottom[slot] = s.value[kb];
+        }
     }
 
     /// Area-weighted radiance of the sub-square with top-left grid point (i, j) and side `size`

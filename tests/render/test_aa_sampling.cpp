@@ -167,9 +167,19 @@ TEST(AaSampling, AlwaysSplitEqualsAnIndependentUniformSubdivision) {
         RenderStats stats;
         Film film = Renderer(s, rs).render(&stats);
         const int n = 1 << depth;
-        // Every point of the (w n + 1) x (h n + 1) lattice is traced, once.
+        // Every point of the (w n + 1) x (h n + 1) lattice is traced, once, whether the pixel edges
+        // it lies on are inside a tile (handed to the next pixel), on a tile border (shared across
+        // tiles) or on the window's border (not shared): one-pixel tiles, uneven tiles, one tile.
         EXPECT_EQ(stats.rays.camera, uint64_t(w * n + 1) * uint64_t(h * n + 1));
         EXPECT_EQ(stats.pixels_subdivided, uint64_t(w * h));
+        for (int tile : {1, 5, 32}) {
+            RenderSettings tiled = rs;
+            tiled.tile_size = tile;
+            RenderStats tiled_stats;
+            const Film tiled_film = Renderer(s, tiled).render(&tiled_stats);
+            EXPECT_EQ(tiled_stats.rays.camera, stats.rays.camera) << "tile " << tile << " depth " << depth;
+            EXPECT_EQ(tiled_film.beauty, film.beauty) << "tile " << tile << " depth " << depth;
+        }
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {
                 Color sum(0.f);

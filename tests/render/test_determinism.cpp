@@ -70,7 +70,7 @@ std::vector<AaSettings> all_aa_modes() {
     modes.push_back(a);
     a.mode = AaMode::Corners;
     modes.push_back(a);
-    a.mode = AaMode::Adaptive;  // the CLI default: threshold 0.1, depth 2
+    a.mode = AaMode::Adaptive;  // the CLI default: threshold 0.1, depth 3
     modes.push_back(a);
     a.threshold = -1.f;  // always split: every edge point is shared
     a.depth = 3;
