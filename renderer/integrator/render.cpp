@@ -131,6 +131,10 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
     auto start = Clock::now();
     m_accel = create_accelerator(settings.accel, scene, m_view, AccelConfig{settings.robust, settings.threads});
     m_build_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    const AccelStats as = m_accel->stats();
+    log_info("accelerator: {}{}, built in {:.3f}s, {:.1f} MiB", m_accel->name(),
+             m_accel->name() == "embree" ? (settings.robust ? " (robust)" : " (not robust: --no-robust)") : "",
+             m_build_seconds, double(as.bytes) / double(1 << 20));
 }
 
 Renderer::~Renderer() = default;

@@ -34,7 +34,7 @@ struct RenderSettings {
     AovSet aovs;                          ///< extra outputs from the pixel-centre camera ray
     AaSettings aa;                        ///< anti-aliasing mode and its parameters
     std::string accel = "embree";         ///< accelerator backend
-    bool robust = false;                  ///< Embree ROBUST mode
+    bool robust = true;                   ///< Embree ROBUST mode: watertight at edges (docs/numerical-stability.md section 3)
     bool progress = false;                ///< progress bar with ETA on stderr (when it is a terminal)
 };
 

@@ -100,6 +100,17 @@ TEST(Cli, PrecisionAndBvFlagsAreSpecOptions) {
     EXPECT_EQ(r.code, 2) << r.err;
 }
 
+// Embree's robust (watertight-at-edges) mode is the default; --no-robust turns it off. The log
+// says which one ran.
+TEST(Cli, EmbreeRobustIsTheDefaultAndNoRobustTurnsItOff) {
+    Result r = run("render '" + kBox + "' --width 16 --no-progress -o /tmp/whitted_cli_robust.png");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("accelerator: embree (robust)"), std::string::npos) << r.err;
+    r = run("render '" + kBox + "' --width 16 --no-progress --no-robust -o /tmp/whitted_cli_robust.png");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("accelerator: embree (not robust"), std::string::npos) << r.err;
+}
+
 TEST(Cli, UnknownOutputExtensionIsAnErrorAndWritesNothing) {
     const fs::path out = fs::temp_directory_path() / "whitted_cli_out.xyz";
     fs::remove(out);
