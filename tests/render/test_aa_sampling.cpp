@@ -152,7 +152,7 @@ TEST(AaSampling, AlwaysSplitEqualsAnIndependentUniformSubdivision) {
     RenderSettings base = settings(w, h, AaMode::Adaptive);
     base.integrator.ambient = Color(0.05f);
     SceneView view(s, base.mapping);
-    auto accel = create_accelerator("embree", s, view, AccelConfig{});
+    auto accel = create_accelerator("embree", s, view, AccelConfig{base.robust, 0});  // as the Renderer builds it
     WhittedIntegrator integrator(view, *accel, base.integrator);
     CameraModel camera(s.cameras[0], w, h);
     auto radiance = [&](double x, double y) {
