@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "renderer/accel/accelerator.h"
+#include "renderer/accel/common/simd.h"
 #include "renderer/core/vecmath.h"
 
 namespace whitted {
@@ -159,15 +160,21 @@ constexpr T kRayTmaxScale = T(1) + T(4) * rounding_gamma<T>(8);
 /// an origin exactly on a plane gives 0 * inf = NaN, which the comparisons below ignore (the ray
 /// lies in the closed slab). The exit distance is enlarged by 1 + 2 gamma(3), so rounding can
 /// never cull a box the ray touches.
+/// Always inlined, axes written out: it is the inner loop of every binary tree (the two-level
+/// top level over instances included), where an out-of-line call per node cost a fifth of the
+/// `bvh` backend's time on multi-instance scenes. Same operations, same results.
 template <typename T>
-inline T slab_entry(const SlabRay<T>& r, const Vec3<T>& lo, const Vec3<T>& hi, T tmin, T tmax) {
+WHITTED_ALWAYS_INLINE T slab_entry(const SlabRay<T>& r, const Vec3<T>& lo, const Vec3<T>& hi, T tmin, T tmax) {
     tmax = tmax * kRayTmaxScale<T> + r.t_slack;
-    for (int k = 0; k < 3; ++k) {
-        const T t_near = ((r.neg[k] ? hi[k] : lo[k]) - r.org[k]) * r.inv_dir[k];
-        const T t_far = ((r.neg[k] ? lo[k] : hi[k]) - r.org[k]) * r.inv_dir[k] * kSlabExitScale<T>;
+    auto axis = [&](T org, T inv_dir, bool neg, T l, T h) WHITTED_ALWAYS_INLINE_LAMBDA {
+        const T t_near = ((neg ? h : l) - org) * inv_dir;
+        const T t_far = ((neg ? l : h) - org) * inv_dir * kSlabExitScale<T>;
         tmin = t_near > tmin ? t_near : tmin;  // NaN compares false: no restriction
         tmax = t_far < tmax ? t_far : tmax;
-    }
+    };
+    axis(r.org.x, r.inv_dir.x, r.neg[0], lo.x, hi.x);
+    axis(r.org.y, r.inv_dir.y, r.neg[1], lo.y, hi.y);
+    axis(r.org.z, r.inv_dir.z, r.neg[2], lo.z, hi.z);
     return tmin <= tmax ? tmin : std::numeric_limits<T>::infinity();
 }
 
@@ -179,7 +186,7 @@ struct AabbVolume {
 };
 
 template <typename T>
-inline T volume_entry(const SlabRay<T>& r, const AabbVolume<T>& v, T tmin, T tmax) {
+WHITTED_ALWAYS_INLINE T volume_entry(const SlabRay<T>& r, const AabbVolume<T>& v, T tmin, T tmax) {
     return slab_entry(r, v.lo, v.hi, tmin, tmax);
 }
 

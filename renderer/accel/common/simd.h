@@ -24,10 +24,13 @@
 
 #if defined(__GNUC__) || defined(__clang__)
 #define WHITTED_ALWAYS_INLINE inline __attribute__((always_inline))
+/// The same for a lambda (after its parameter list).
+#define WHITTED_ALWAYS_INLINE_LAMBDA __attribute__((always_inline))
 /// Inlines every call made in the function (where possible), recursively.
 #define WHITTED_FLATTEN __attribute__((flatten))
 #else
 #define WHITTED_ALWAYS_INLINE inline
+#define WHITTED_ALWAYS_INLINE_LAMBDA
 #define WHITTED_FLATTEN
 #endif
 
