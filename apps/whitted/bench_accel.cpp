@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/whitted/bench_timing.h"
 #include "apps/whitted/command.h"
 #include "apps/whitted/ray_recording.h"
 #include "importers/scene_file_geometry.h"
@@ -355,14 +356,6 @@ double near_origin_distance(const Scene& scene) {
     return std::isfinite(d) && d > 0 ? 1e-4 * d : 1e-4;
 }
 
-/// CPU time of the calling thread: time the thread was descheduled (other processes on a
-/// loaded machine) does not count.
-double thread_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
 /// Mrays/s of one ray set on `threads` threads (the best of 3 runs). One thread traces on the
 /// calling thread and is timed by its CPU time (time descheduled by other processes on a shared
 /// machine does not count); more threads run over TBB and are timed by the wall clock. Slow
@@ -372,7 +365,7 @@ double throughput(const Accelerator& accel, const std::vector<RecordedRay>& rays
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     const bool cpu_clock = threads == 1;
     auto now = [&] {
-        return cpu_clock ? thread_seconds() : std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
+        return cpu_clock ? thread_cpu_seconds() : std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
     };
     // Probe the cost per ray on a small prefix: up to 512 rays, fewer once they take a tenth of
     // the time allowed (brute force over a million triangles takes ~10 ms per ray).
@@ -410,9 +403,9 @@ double ns_per_ray(const Accelerator& accel, const std::vector<RecordedRay>& rays
     double best = 1e30, total = 0.0;
     for (int p = 0; p < 1000 && (p < min_passes || total < 0.15); ++p) {
         volatile float sink = 0.f;
-        const double t = thread_seconds();
+        const double t = thread_cpu_seconds();
         for (const RecordedRay& r : rays) sink = sink + trace(accel, r);
-        const double dt = thread_seconds() - t;
+        const double dt = thread_cpu_seconds() - t;
         best = std::min(best, dt);
         total += dt;
     }
@@ -437,8 +430,8 @@ std::string csv_cell(const std::string& s) { return s.find(',') == std::string::
 
 /// The 1-minute load average alone (a CSV cell).
 std::string load_1min() {
-    const std::string l = load_average();
-    return l.substr(0, l.find(' '));
+    const double l = load_average_1min();
+    return l < 0 ? "unknown" : fmt::format("{:.2f}", l);
 }
 
 /// The sizes a scene name runs at: every --sizes value for a generator, once for a scene file.

@@ -16,6 +16,14 @@ inline double process_cpu_seconds() {
     return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
+/// CPU time of the calling thread in seconds: with work on one thread, the time it was
+/// descheduled (other processes on a loaded machine) does not count.
+inline double thread_cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
 /// The 1-minute load average, or -1 when unavailable.
 inline double load_average_1min() {
     double l[1] = {0.0};
