@@ -16,10 +16,15 @@
 //       (one BVH per mesh, one instance per Instance, build quality MEDIUM) measures rtcIntersect1
 //       against rtcIntersect4/8/16 on the recorded camera rays, rtcOccluded1 with and without an
 //       occlusion filter on the recorded shadow rays, and the BVH's bytes through Embree's memory
-//       monitor.
+//       monitor;
+//   (f) the centre-sample camera pass without the film, one thread, in tiles with rows of up to 16
+//       samples: the general kernel ray by ray, the specialised kernel ray by ray, and the
+//       specialised kernel with WhittedIntegrator::trace_camera (one batch query per row: Embree
+//       packets), and the Whitted overhead of each pass against a replay of its own recorded rays
+//       (batches replayed as batches).
 // Times are process CPU seconds with --threads 1 (robust on a shared machine) and wall-clock
 // seconds otherwise; medians of --repeat runs. Writes <out>/skip.csv, skip_overhead.csv,
-// skip_packets.csv and (python3 with matplotlib) the error-against-time plot of the min-weight
+// skip_packets.csv, skip_camera_pass.csv and (python3 with matplotlib) the error-against-time plot of the min-weight
 // sweep through scripts/plot_skip.py.
 #include <embree3/rtcore.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -30,6 +35,7 @@
 #include <pmmintrin.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -50,6 +56,7 @@
 #include "renderer/accel/embree/embree_ray.h"
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
+#include "renderer/integrator/camera.h"
 #include "renderer/integrator/render.h"
 #include "renderer/output/image_output.h"
 
@@ -81,9 +88,11 @@ struct BenchSkipOptions {
     std::string aa = "center";         ///< anti-aliasing mode (center: one camera ray per pixel)
     std::vector<float> min_weights{0.f, 1e-4f, 1e-3f, 1.f / 255.f, 0.01f, 0.03f, 0.1f};
     std::string out = "out/bench_skip";
+    std::string accel = "embree";      ///< accelerator backend and options (e.g. embree:packet=8)
     float mirror_cutoff = MappingOptions{}.mirror_roughness_cutoff;  ///< glTF mapping, as --mirror-cutoff
     bool plot = true;
     bool packets = true;               ///< (e): private Embree scene for mesh-only scenes
+    bool camera_pass = true;           ///< (f): camera pass, ray by ray and with batch queries
 };
 
 std::vector<std::string> default_scenes() {
@@ -191,26 +200,65 @@ void set_ftz_daz() {
     _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
 }
 
-/// Seconds to replay `rays` through `accel` in blocks of 1024 consecutive rays on `threads`
-/// threads (median of `repeat` runs).
+/// Seconds to replay `rays` through `accel` in blocks of about 1024 consecutive rays on `threads`
+/// threads (median of `repeat` runs). Blocks start at query boundaries, so recorded batch queries
+/// (rows of camera rays) are replayed as batches: packets where the render used packets.
 double replay_seconds(const Accelerator& accel, const std::vector<RecordedRay>& rays, int threads, int repeat) {
+    std::vector<size_t> starts{0};
+    for (size_t i = 0; i < rays.size(); ++i)
+        if (i - starts.back() >= 1024 && rays[i].batch != 0) starts.push_back(i);
+    starts.push_back(rays.size());
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(std::max(1, threads)));
     std::vector<double> t;
     for (int run = 0; run < std::max(1, repeat); ++run) {
         const double start = clock_now();
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, starts.size() - 1), [&](const tbb::blocked_range<size_t>& r) {
             set_ftz_daz();
+            std::vector<Ray> batch;
+            std::vector<Hit> hits;
             float sink = 0.f;
-            for (size_t i = r.begin(); i != r.end(); ++i) {
-                const RecordedRay& rr = rays[i];
-                sink += rr.shadow ? accel.transmittance(rr.ray).x : accel.intersect(rr.ray, rr.kind).t;
-            }
+            for (size_t b = r.begin(); b != r.end(); ++b) sink += replay(accel, rays, starts[b], starts[b + 1], batch, hits);
             volatile float keep = sink;
             (void)keep;
         });
         t.push_back(clock_now() - start);
     }
     return median(t);
+}
+
+// ---- (f) the camera pass: general, specialised, specialised + packets ----
+
+/// One centre sample per pixel in tiles of `tile` pixels, each tile row cut into rows of up to 16
+/// samples (what render.cpp's tile loops would batch), without the film, in the calling thread.
+/// `packets`: each row through WhittedIntegrator::trace_camera (one batch query in the specialised
+/// kernels); otherwise trace() ray by ray. Returns the radiance per pixel, row-major.
+std::vector<Color> camera_pass(const CameraModel& camera, const WhittedIntegrator& integrator, ImageSize size, int tile,
+                               bool packets, RayCounters& rc) {
+    std::vector<Color> image(size_t(size.width) * size_t(size.height));
+    const RayCone cone = camera.pixel_cone();
+    std::array<Ray, 16> rays;
+    std::array<Color, 16> radiance;
+    for (int ty = 0; ty < size.height; ty += tile)
+        for (int tx = 0; tx < size.width; tx += tile)
+            for (int y = ty; y < std::min(size.height, ty + tile); ++y)
+                for (int x0 = tx; x0 < std::min(size.width, tx + tile); x0 += 16) {
+                    const size_t n = size_t(std::min({16, size.width - x0, tx + tile - x0}));
+                    camera.generate_row(x0 + 0.5, 1.0, y + 0.5, std::span(rays.data(), n));
+                    if (packets) {
+                        integrator.trace_camera(std::span(rays.data(), n), std::span(radiance.data(), n), rc, cone);
+                    } else {
+                        for (size_t i = 0; i < n; ++i)
+                            radiance[i] = integrator.trace(rays[i], RayKind::Camera, 0, rc, nullptr, cone);
+                    }
+                    std::copy_n(radiance.begin(), n, image.begin() + ptrdiff_t(size_t(y) * size_t(size.width) + size_t(x0)));
+                }
+    return image;
+}
+
+uint64_t differing(const std::vector<Color>& a, const std::vector<Color>& b) {
+    uint64_t d = 0;
+    for (size_t i = 0; i < a.size(); ++i) d += !(a[i] == b[i]);
+    return d;
 }
 
 // ---- (e) a private Embree scene: packets, filters, BVH bytes ----
@@ -399,6 +447,9 @@ int run_bench_skip(const BenchSkipOptions& o) {
            "max_abs,rmse_linear,rmse_display\n";
     ocsv << "scene,threads,clock,rays,camera,shadow,secondary,render_s,render_mrays,replay_s,replay_mrays,overhead_ratio,load\n";
     pcsv << "scene,query,width,threads,mrays_per_s,load\n";
+    std::ofstream ccsv(out / "skip_camera_pass.csv");
+    ccsv << "scene,variant,min_weight,clock,median_s,rays,camera,mrays_per_s,speedup_vs_general,differing_pixels,"
+            "replay_s,replay_mrays,overhead_ratio,load\n";
     const int hw = tbb::this_task_arena::max_concurrency();
     const int threads = o.threads > 0 ? o.threads : hw;
     g_cpu_clock = threads == 1;
@@ -413,6 +464,7 @@ int run_bench_skip(const BenchSkipOptions& o) {
         rs.width = o.width;
         rs.height = 0;
         rs.threads = o.threads;
+        rs.accel = o.accel;
         rs.aa.mode = parse_aa_mode(o.aa);
         rs.mapping.mirror_roughness_cutoff = o.mirror_cutoff;
         rs.progress = false;
@@ -461,6 +513,55 @@ int run_bench_skip(const BenchSkipOptions& o) {
         std::printf("   speed-up specialised / general: %.3fx (medians), images %s\n",
                     mg.median_seconds / ms.median_seconds, ds.differing_pixels == 0 ? "identical" : "DIFFER");
         write_image(ms.film, (out / (label + ".png")).string(), OutputSettings{});
+
+        // (f) the camera pass: general / specialised ray by ray / specialised + packets (one thread).
+        if (o.camera_pass) {
+            const CameraModel camera(scene.cameras[size_t(rs.camera)], size.width, size.height);
+            struct Variant {
+                const char* name;
+                IntegratorSettings settings;
+                bool packets;
+            };
+            for (const float mw : {0.f, 1.f / 255.f}) {
+                IntegratorSettings g = general, sp = special;
+                g.min_weight = sp.min_weight = mw;
+                const Variant variants[] = {{"general", g, false}, {"specialised", sp, false}, {"specialised+packets", sp, true}};
+                std::vector<std::vector<double>> t(std::size(variants));
+                std::vector<std::vector<Color>> images(std::size(variants));
+                std::vector<RayCounters> counts(std::size(variants));
+                for (int run = 0; run < std::max(1, o.repeat); ++run)
+                    for (size_t k = 0; k < std::size(variants); ++k) {
+                        const WhittedIntegrator integrator(renderer.view(), renderer.accelerator(), variants[k].settings);
+                        RayCounters rc;
+                        const double start = clock_now();
+                        images[k] = camera_pass(camera, integrator, size, rs.tile_size, variants[k].packets, rc);
+                        t[k].push_back(clock_now() - start);
+                        counts[k] = rc;
+                    }
+                const double load = load_average();
+                const double tg = median(t[0]);
+                for (size_t k = 0; k < std::size(variants); ++k) {
+                    // Its own rays recorded (batches kept) and replayed through the bare accelerator.
+                    RecordingAccelerator recorder(renderer.accelerator());
+                    const WhittedIntegrator integrator(renderer.view(), recorder, variants[k].settings);
+                    RayCounters rc;
+                    (void)camera_pass(camera, integrator, size, rs.tile_size, variants[k].packets, rc);
+                    const std::vector<RecordedRay> rays = recorder.rays();
+                    const double replay = replay_seconds(renderer.accelerator(), rays, 1, o.repeat);
+                    const double tk = median(t[k]);
+                    const double mr = double(rays.size()) / tk * 1e-6, replay_mr = double(rays.size()) / replay * 1e-6;
+                    const uint64_t diff = differing(images[k], images[0]);
+                    std::printf("   camera pass %-20s mw=%-9.6g %8.4fs %9zu rays %7.2f Mr/s, %.3fx general, diff px %llu | "
+                                "replay %7.2f Mr/s, overhead ratio %.3f | load %.2f\n",
+                                variants[k].name, double(mw), tk, rays.size(), mr, tg / tk, (unsigned long long)diff,
+                                replay_mr, mr / replay_mr, load);
+                    ccsv << fmt::format("{},{},{:g},{},{:.6f},{},{},{:.4f},{:.4f},{},{:.6f},{:.4f},{:.4f},{:.2f}\n", label,
+                                        variants[k].name, mw, g_cpu_clock ? "cpu" : "wall", tk, rays.size(),
+                                        counts[k].camera, mr, tg / tk, diff, replay, replay_mr, mr / replay_mr, load);
+                }
+            }
+            ccsv.flush();
+        }
 
         // (c) the min_weight sweep (specialised kernel, interleaved), errors against min_weight 0.
         std::vector<IntegratorSettings> sweep;
@@ -562,8 +663,8 @@ int run_bench_skip(const BenchSkipOptions& o) {
         ocsv.flush();
         pcsv.flush();
     }
-    std::printf("\nwrote %s, %s, %s\n", (out / "skip.csv").c_str(), (out / "skip_overhead.csv").c_str(),
-                (out / "skip_packets.csv").c_str());
+    std::printf("\nwrote %s, %s, %s, %s\n", (out / "skip.csv").c_str(), (out / "skip_overhead.csv").c_str(),
+                (out / "skip_packets.csv").c_str(), (out / "skip_camera_pass.csv").c_str());
 
     if (o.plot) {
         const fs::path script = fs::path(WHITTED_SOURCE_DIR) / "scripts" / "plot_skip.py";
@@ -594,8 +695,10 @@ Command register_bench_skip(CLI::App& bench) {
     app->add_option("--mirror-cutoff", o->mirror_cutoff,
                     "glTF roughness at which mirror reflection has faded to 0 (0 = no glTF mirrors)")
         ->check(CLI::Range(0.0f, 1.0f))->capture_default_str();
+    app->add_option("--accel", o->accel, "Accelerator backend with options (docs/accelerators.md)")->capture_default_str();
     app->add_option("-o,--out", o->out, "Output directory: CSVs, images, plot")->capture_default_str();
     app->add_flag("!--no-plot", o->plot, "Do not run scripts/plot_skip.py");
+    app->add_flag("!--no-camera-pass", o->camera_pass, "Skip (f), the camera pass with and without packets");
     app->add_flag("!--no-packets", o->packets, "Skip the private Embree scene (packets, filters, BVH bytes)");
     return Command{app, [o] { return run_bench_skip(*o); }};
 }

@@ -1,10 +1,16 @@
 // Ray recording for the benchmarks: a decorator of an Accelerator that logs every query a render
 // makes, so `bench skip` (the Whitted overhead) and `bench accel` (incoherent rays recorded from a
-// real render's secondary rays) can replay exactly the rays a render traced.
+// real render's secondary rays) can replay exactly the rays a render traced. Batch queries
+// (Accelerator::intersect over a span: the integrator's rows of camera rays) are forwarded as
+// batches and their boundaries kept, so a replay can trace them as batches too (packets where the
+// render used packets).
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
 
+#include <algorithm>
+#include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -15,8 +21,34 @@ namespace whitted::app {
 struct RecordedRay {
     Ray ray;
     RayKind kind;
-    bool shadow;  ///< a transmittance query (else closest hit)
+    bool shadow;          ///< a transmittance query (else closest hit)
+    uint32_t batch = 1;   ///< first ray of a query: rays in that query (1 = single-ray); 0 = later
+                          ///< ray of a batch query
 };
+
+/// Replays `rays[begin, end)` (which must start at a query boundary) through `accel` query by
+/// query: batches as one batch query (cut at `end`), the others one ray at a time. Returns a sum of
+/// the results (for the caller to keep, so nothing is optimised away). `batch`, `hits`: scratch.
+inline float replay(const Accelerator& accel, const std::vector<RecordedRay>& rays, size_t begin, size_t end,
+                    std::vector<Ray>& batch, std::vector<Hit>& hits) {
+    float sink = 0.f;
+    for (size_t i = begin; i < end;) {
+        const RecordedRay& rr = rays[i];
+        if (rr.batch > 1) {
+            const size_t n = std::min<size_t>(rr.batch, end - i);
+            batch.clear();
+            for (size_t k = i; k < i + n; ++k) batch.push_back(rays[k].ray);
+            hits.resize(batch.size());
+            accel.intersect(batch, rr.kind, hits);
+            for (const Hit& h : hits) sink += h.t;
+            i += n;
+        } else {
+            sink += rr.shadow ? accel.transmittance(rr.ray).x : accel.intersect(rr.ray, rr.kind).t;
+            ++i;
+        }
+    }
+    return sink;
+}
 
 /// Forwards every query to `inner` and keeps a per-thread log of the rays.
 class RecordingAccelerator final : public Accelerator {
@@ -25,6 +57,11 @@ public:
     Hit intersect(const Ray& ray, RayKind kind) const override {
         m_log.local().push_back({ray, kind, false});
         return m_inner.intersect(ray, kind);
+    }
+    void intersect(std::span<const Ray> rays, RayKind kind, std::span<Hit> hits) const override {
+        std::vector<RecordedRay>& log = m_log.local();
+        for (size_t i = 0; i < rays.size(); ++i) log.push_back({rays[i], kind, false, i == 0 ? uint32_t(rays.size()) : 0u});
+        m_inner.intersect(rays, kind, hits);
     }
     Color transmittance(const Ray& ray) const override {
         m_log.local().push_back({ray, RayKind::Shadow, true});

@@ -41,7 +41,7 @@ CameraModel::CameraModel(const Camera& camera, int width, int height)
     m_zfar = camera.zfar > 0 ? camera.zfar : 0.0;
 }
 
-Ray CameraModel::generate(double x, double y) const {
+inline Ray CameraModel::make_ray(double x, double y) const {
     // Normalized device coordinates in [-1, 1], +y up. One division per ray (the reciprocal of
     // the length): this runs once per camera sample, next to a cheap Embree miss for background.
     const double sx = (x * m_ndc_x - 1.0) * m_half_w;
@@ -63,6 +63,13 @@ Ray CameraModel::generate(double x, double y) const {
         r.tfar = m_zfar > 0 ? float(m_zfar) : kInfinity;
     }
     return r;
+}
+
+Ray CameraModel::generate(double x, double y) const { return make_ray(x, y); }
+
+void CameraModel::generate_row(double x0, double dx, double y, std::span<Ray> rays) const {
+    // make_ray is inlined here, so consecutive rays' divisions overlap.
+    for (size_t i = 0; i < rays.size(); ++i) rays[i] = make_ray(x0 + double(i) * dx, y);
 }
 
 RayCone CameraModel::pixel_cone() const {

@@ -1,6 +1,8 @@
 // Camera rays from a Scene camera (perspective or orthographic, glTF conventions).
 #pragma once
 
+#include <span>
+
 #include "renderer/accel/accelerator.h"
 #include "renderer/integrator/scene_view.h"
 #include "renderer/scene/scene.h"
@@ -23,12 +25,17 @@ public:
     /// Ray through image position (x, y) in pixels, (0, 0) = top-left corner of the image,
     /// (width, height) = bottom-right; pixel centres are at +0.5. Direction is unit length.
     Ray generate(double x, double y) const;
+    /// A row of rays: rays[i] = generate(x0 + i * dx, y), bit for bit. Generating a row before
+    /// tracing it lets the divisions and square roots of neighbouring rays overlap in the pipeline
+    /// (one ray's generate() waits on its own: about 9% of an opaque one-thread render's samples).
+    void generate_row(double x0, double dx, double y, std::span<Ray> rays) const;
     /// Footprint of one pixel as a ray cone: perspective cameras spread by the angle one pixel
     /// subtends at the image centre (2 tan(yfov/2) / height), orthographic ones have a constant
     /// width of one pixel. Used for texture MIP selection, whatever the anti-aliasing mode.
     RayCone pixel_cone() const;
 
 private:
+    Ray make_ray(double x, double y) const;  ///< generate()'s body, inlined into generate_row()
     CameraType m_type;
     Vec3d m_origin, m_right, m_up, m_forward;  ///< world-space camera frame (unit axes)
     double m_half_w = 1, m_half_h = 1;         ///< image-plane half extents at distance 1 (or ortho mags)

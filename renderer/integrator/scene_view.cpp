@@ -118,7 +118,7 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
     const uint32_t i0 = mesh.indices[size_t(hit.prim) * 3 + 0];
     const uint32_t i1 = mesh.indices[size_t(hit.prim) * 3 + 1];
     const uint32_t i2 = mesh.indices[size_t(hit.prim) * 3 + 2];
-    const float u = hit.u, v = hit.v, w = 1.f - hit.u - hit.v;
+    const float u = hit.u, v = hit.v;
     sp.material = mesh.material;
 
     // Position from the world-space vertices (not o + t d), transformed and blended in double

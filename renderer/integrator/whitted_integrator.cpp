@@ -1,6 +1,7 @@
 #include "renderer/integrator/whitted_integrator.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iterator>
 #include <limits>
@@ -315,7 +316,10 @@ WhittedIntegrator::WhittedIntegrator(const SceneView& view, const Accelerator& a
       m_kernel(select_kernel(view.analysis().features, settings)) {
     // The instantiation for the selected features, chosen once (no per-ray dispatch below).
     auto pick = [&]<size_t... I>(std::index_sequence<I...>) {
-        ((m_kernel == kKernels[I] ? (void)(m_trace = kernel_entry<kKernels[I]>()) : (void)0), ...);
+        ((m_kernel == kKernels[I] ? (void)(m_trace = kernel_entry<kKernels[I]>(),
+                                           m_trace_camera = camera_entry<kKernels[I]>())
+                                  : (void)0),
+         ...);
     };
     pick(std::make_index_sequence<std::size(kKernels)>{});
     RT_CHECK(m_trace != nullptr);
@@ -329,6 +333,40 @@ Color WhittedIntegrator::trace_kernel(const Ray& ray, RayKind kind, int depth, R
     const Hit hit = m_accel.intersect(ray, kind);
     if (!hit.valid()) return m_settings.background;
     return sanitize(shade<K>(ray, hit, depth, counters, primary, cone, weight));
+}
+
+void WhittedIntegrator::trace_camera(std::span<const Ray> rays, std::span<Color> radiance, RayCounters& counters,
+                                     const RayCone& cone, std::span<PrimaryInfo> primary) const {
+    RT_CHECK(radiance.size() == rays.size());
+    if (!primary.empty()) RT_CHECK(primary.size() == rays.size());
+    (this->*m_trace_camera)(rays, radiance, counters, cone, primary);
+}
+
+template <KernelFeatures K>
+void WhittedIntegrator::trace_camera_kernel(std::span<const Ray> rays, std::span<Color> radiance, RayCounters& counters,
+                                            const RayCone& cone, std::span<PrimaryInfo> primary) const {
+    if constexpr (K == kGeneralKernel) {
+        // The general path stays one closest-hit query per ray (the baseline packets are measured
+        // against, docs/performance.md).
+        for (size_t i = 0; i < rays.size(); ++i)
+            radiance[i] = trace_kernel<K>(rays[i], RayKind::Camera, 0, counters, primary.empty() ? nullptr : &primary[i],
+                                          cone, 1.f);
+    } else {
+        // One batch query per chunk (coherent packets in the Embree backend), then the hits are
+        // shaded in order exactly as trace_kernel() shades them.
+        std::array<Hit, kCameraBatch> hits;
+        for (size_t begin = 0; begin < rays.size(); begin += kCameraBatch) {
+            const size_t n = std::min(kCameraBatch, rays.size() - begin);
+            m_accel.intersect(rays.subspan(begin, n), RayKind::Camera, std::span(hits).first(n));
+            counters.camera += n;
+            for (size_t j = 0; j < n; ++j) {
+                const size_t i = begin + j;
+                radiance[i] = hits[j].valid() ? sanitize(shade<K>(rays[i], hits[j], 0, counters,
+                                                                   primary.empty() ? nullptr : &primary[i], cone, 1.f))
+                                              : m_settings.background;
+            }
+        }
+    }
 }
 
 void WhittedIntegrator::probe(const Ray& ray, RayCounters& counters, PrimaryInfo& primary) const {

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "renderer/accel/accelerator.h"
@@ -102,6 +103,18 @@ public:
                 const RayCone& cone = {}, float weight = 1.f) const {
         return (this->*m_trace)(ray, kind, depth, counters, primary, cone, weight);
     }
+    /// Radiance of a batch of camera rays (depth 0, path weight 1, one footprint `cone`), written to
+    /// radiance[i] (radiance.size() == rays.size(), and primary.size() too when not empty; else
+    /// throws). Each entry is what trace(rays[i], RayKind::Camera, 0, counters, &primary[i], cone)
+    /// gives, counted the same way, except where the accelerator's batch query names another
+    /// primitive at a tied closest t (Accelerator::intersect over a span). The specialised kernels
+    /// issue one batch query per up to kCameraBatch rays (Embree: coherent packets) and then shade
+    /// the hits one by one; the general kernel (--no-specialize) traces ray by ray, so the gain of
+    /// packets stays measurable. Rows of neighbouring samples are what it is for.
+    void trace_camera(std::span<const Ray> rays, std::span<Color> radiance, RayCounters& counters,
+                      const RayCone& cone = {}, std::span<PrimaryInfo> primary = {}) const;
+    /// Rays per batch query of trace_camera (longer spans are split).
+    static constexpr size_t kCameraBatch = 64;
     /// First-hit data only (no shading, no secondary rays) for a camera ray: AOVs of pixel centres
     /// in anti-aliasing modes that trace no centre sample. Counted as `aov_probe`.
     void probe(const Ray& ray, RayCounters& counters, PrimaryInfo& primary) const;
@@ -119,11 +132,18 @@ private:
     template <KernelFeatures K>
     Color trace_kernel(const Ray& ray, RayKind kind, int depth, RayCounters& counters, PrimaryInfo* primary,
                        const RayCone& cone, float weight) const;
+    using CameraFn = void (WhittedIntegrator::*)(std::span<const Ray>, std::span<Color>, RayCounters&, const RayCone&,
+                                                  std::span<PrimaryInfo>) const;
+    template <KernelFeatures K>
+    void trace_camera_kernel(std::span<const Ray> rays, std::span<Color> radiance, RayCounters& counters,
+                             const RayCone& cone, std::span<PrimaryInfo> primary) const;
     template <KernelFeatures K>
     Color shade(const Ray& ray, const Hit& hit, int depth, RayCounters& counters, PrimaryInfo* primary,
                 const RayCone& cone, float weight) const;
     template <KernelFeatures K>
     static TraceFn kernel_entry() { return &WhittedIntegrator::trace_kernel<K>; }
+    template <KernelFeatures K>
+    static CameraFn camera_entry() { return &WhittedIntegrator::trace_camera_kernel<K>; }
     /// The medium of a touching dielectric whose face coincides with the surface hit (see
     /// DielectricContacts): its coefficients there and the point on its face.
     struct OtherMedium {
@@ -138,6 +158,7 @@ private:
     IntegratorSettings m_settings;
     KernelFeatures m_kernel;
     TraceFn m_trace = nullptr;
+    CameraFn m_trace_camera = nullptr;
     std::shared_ptr<const DielectricContacts> m_contacts;  ///< null when no dielectrics touch
 };
 
