@@ -10,11 +10,13 @@
 #include <pmmintrin.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <mutex>
+#include <span>
 #include <sstream>
 
 #include "renderer/core/error.h"
@@ -216,13 +218,42 @@ public:
         return c;
     }
 
-    /// center: one ray through each pixel centre (it also gives the AOVs).
+    /// Samples traced together by sample_row: a coherent row (the integrator's batch size).
+    static constexpr int kRow = int(WhittedIntegrator::kCameraBatch);
+
+    /// n <= kRow primary samples at image positions pos(0) .. pos(n - 1), traced as one batch
+    /// (WhittedIntegrator::trace_camera: Embree packets in the specialised kernels): out[i] is what
+    /// sample() gives at pos(i), the same arithmetic in the same order. `info` may be null.
+    template <class Pos>
+    void sample_row(int n, Pos&& pos, Color* out, RayCounters& rc, PrimaryInfo* info = nullptr) {
+        std::array<Ray, kRow> rays;
+        for (int i = 0; i < n; ++i) {
+            const auto [x, y] = pos(i);
+            rays[size_t(i)] = m_camera.generate(x, y);
+        }
+        m_integrator.trace_camera(std::span<const Ray>(rays.data(), size_t(n)), std::span<Color>(out, size_t(n)), rc,
+                                  m_cone, info ? std::span<PrimaryInfo>(info, size_t(n)) : std::span<PrimaryInfo>{});
+        for (int i = 0; i < n; ++i) {
+            Color c = out[i] * m_exposure;
+            if (!is_finite(c)) {
+                ++m_nonfinite;
+                c = Color(0.f);
+            }
+            out[i] = c;
+        }
+    }
+
+    /// center: one ray through each pixel centre (it also gives the AOVs), rows of a tile in batches.
     void center_tile(const Rect& r, RayCounters& rc) {
+        const bool aovs = m_film.aovs.needs_first_hit();
         for (int y = r.y0; y < r.y1; ++y)
-            for (int x = r.x0; x < r.x1; ++x) {
-                PrimaryInfo info;
-                const Color c = sample(x + 0.5, y + 0.5, rc, m_film.aovs.needs_first_hit() ? &info : nullptr);
-                finish_pixel(x, y, c, 1.f, &info, rc);
+            for (int x0 = r.x0; x0 < r.x1; x0 += kRow) {
+                const int n = std::min(kRow, r.x1 - x0);
+                std::array<Color, kRow> c;
+                std::array<PrimaryInfo, kRow> info;
+                sample_row(n, [&](int i) { return std::pair(x0 + i + 0.5, y + 0.5); }, c.data(), rc,
+                           aovs ? info.data() : nullptr);
+                for (int i = 0; i < n; ++i) finish_pixel(x0 + i, y, c[size_t(i)], 1.f, &info[size_t(i)], rc);
             }
     }
 
@@ -234,19 +265,23 @@ public:
             for (int x = r.x0; x < r.x1; ++x) {
                 // Seeded by the full-image pixel index: crops and tiles see the same jitter.
                 const uint64_t pixel = uint64_t(y) * uint64_t(m_film.full_width) + uint64_t(x);
+                // Sample s = j k + i of the pixel, in the order the sum takes them.
+                auto position = [&](int s) {
+                    const int j = s / k, i = s % k;
+                    const uint64_t key = ((pixel << 12 | uint64_t(s)) << 1);
+                    const double u = (i + double(hash_to_unit_float(key))) * inv_k;
+                    const double v = (j + double(hash_to_unit_float(key | 1))) * inv_k;
+                    if (m_aa.filter == PixelFilter::Tent)
+                        return std::pair(x + 0.5 + double(sample_tent(float(u))), y + 0.5 + double(sample_tent(float(v))));
+                    return std::pair(x + u, y + v);
+                };
                 Color sum(0.f);
-                for (int j = 0; j < k; ++j)
-                    for (int i = 0; i < k; ++i) {
-                        const uint64_t key = ((pixel << 12 | uint64_t(j * k + i)) << 1);
-                        const double u = (i + double(hash_to_unit_float(key))) * inv_k;
-                        const double v = (j + double(hash_to_unit_float(key | 1))) * inv_k;
-                        double sx = x + u, sy = y + v;
-                        if (m_aa.filter == PixelFilter::Tent) {
-                            sx = x + 0.5 + double(sample_tent(float(u)));
-                            sy = y + 0.5 + double(sample_tent(float(v)));
-                        }
-                        sum += sample(sx, sy, rc);
-                    }
+                for (int s0 = 0; s0 < k * k; s0 += kRow) {
+                    const int n = std::min(kRow, k * k - s0);
+                    std::array<Color, kRow> c;
+                    sample_row(n, [&](int i) { return position(s0 + i); }, c.data(), rc);
+                    for (int i = 0; i < n; ++i) sum += c[size_t(i)];
+                }
                 finish_pixel(x, y, sum * float(1.0 / m_aa.spp), float(m_aa.spp), nullptr, rc);
             }
     }
@@ -259,7 +294,12 @@ public:
         const int cx1 = r.x1 == w.x1 ? r.x1 + 1 : r.x1;
         const int cy1 = r.y1 == w.y1 ? r.y1 + 1 : r.y1;
         for (int y = r.y0; y < cy1; ++y)
-            for (int x = r.x0; x < cx1; ++x) m_lattice[lattice_index(x, y)] = sample(x, y, rc);
+            for (int x0 = r.x0; x0 < cx1; x0 += kRow) {
+                const int n = std::min(kRow, cx1 - x0);
+                std::array<Color, kRow> c;
+                sample_row(n, [&](int i) { return std::pair(double(x0 + i), double(y)); }, c.data(), rc);
+                for (int i = 0; i < n; ++i) m_lattice[lattice_index(x0 + i, y)] = c[size_t(i)];
+            }
     }
 
     /// corners: pixel = mean of its 4 lattice corners.
