@@ -481,7 +481,7 @@ private:
     double m_build_seconds = 0.0;
     std::atomic<int64_t> m_device_bytes{0};  ///< the memory monitor's count for m_device
     size_t m_sphere_bytes = 0;               ///< SpherePrims, ours (user data)
-    int m_packet_width = 16;  ///< EmbreeConfig::packet_width
+    int m_packet_width = 4;   ///< EmbreeConfig::packet_width
 };
 
 }  // namespace

@@ -13,7 +13,7 @@ namespace whitted {
 struct EmbreeConfig {
     bool robust = false;   ///< RTC_SCENE_FLAG_ROBUST: slower traversal that avoids some edge misses
     int threads = 0;       ///< build threads, 0 = all
-    int packet_width = 16; ///< batch closest-hit queries: rays per rtcIntersect4/8/16 packet, 1 = rtcIntersect1 each
+    int packet_width = 4;  ///< batch closest-hit queries: rays per rtcIntersect4/8/16 packet, 1 = rtcIntersect1 each
     bool compact = false;  ///< RTC_SCENE_FLAG_COMPACT: leaves index the vertices instead of copying them
                            ///< (-28 MB on a 1M-triangle mesh, 3-8% slower camera rays; docs/performance.md)
 };
