@@ -221,19 +221,14 @@ public:
     /// Samples traced together by sample_row: a coherent row (the integrator's batch size).
     static constexpr int kRow = int(WhittedIntegrator::kCameraBatch);
 
-    /// n <= kRow primary samples at image positions pos(0) .. pos(n - 1), traced as one batch
-    /// (WhittedIntegrator::trace_camera: Embree packets in the specialised kernels): out[i] is what
-    /// sample() gives at pos(i), the same arithmetic in the same order. `info` may be null.
-    template <class Pos>
-    void sample_row(int n, Pos&& pos, Color* out, RayCounters& rc, PrimaryInfo* info = nullptr) {
-        std::array<Ray, kRow> rays;
-        for (int i = 0; i < n; ++i) {
-            const auto [x, y] = pos(i);
-            rays[size_t(i)] = m_camera.generate(x, y);
-        }
-        m_integrator.trace_camera(std::span<const Ray>(rays.data(), size_t(n)), std::span<Color>(out, size_t(n)), rc,
-                                  m_cone, info ? std::span<PrimaryInfo>(info, size_t(n)) : std::span<PrimaryInfo>{});
-        for (int i = 0; i < n; ++i) {
+    /// Up to kRow camera rays traced as one batch (WhittedIntegrator::trace_camera: Embree packets
+    /// in the specialised kernels): out[i] is what sample() gives for rays[i], the same arithmetic
+    /// in the same order. `info` may be null.
+    void trace_row(std::span<const Ray> rays, Color* out, RayCounters& rc, PrimaryInfo* info = nullptr) {
+        const size_t n = rays.size();
+        m_integrator.trace_camera(rays, std::span<Color>(out, n), rc, m_cone,
+                                  info ? std::span<PrimaryInfo>(info, n) : std::span<PrimaryInfo>{});
+        for (size_t i = 0; i < n; ++i) {
             Color c = out[i] * m_exposure;
             if (!is_finite(c)) {
                 ++m_nonfinite;
@@ -241,6 +236,15 @@ public:
             }
             out[i] = c;
         }
+    }
+
+    /// n <= kRow samples along an image row, at (x0 + i, y): generated as a row (bit for bit the
+    /// rays generate() gives) and traced as one batch.
+    void sample_row(int n, double x0, double y, Color* out, RayCounters& rc, PrimaryInfo* info = nullptr) {
+        std::array<Ray, kRow> rays;
+        const std::span<Ray> row(rays.data(), size_t(n));
+        m_camera.generate_row(x0, 1.0, y, row);
+        trace_row(row, out, rc, info);
     }
 
     /// center: one ray through each pixel centre (it also gives the AOVs), rows of a tile in batches.
@@ -251,8 +255,7 @@ public:
                 const int n = std::min(kRow, r.x1 - x0);
                 std::array<Color, kRow> c;
                 std::array<PrimaryInfo, kRow> info;
-                sample_row(n, [&](int i) { return std::pair(x0 + i + 0.5, y + 0.5); }, c.data(), rc,
-                           aovs ? info.data() : nullptr);
+                sample_row(n, x0 + 0.5, y + 0.5, c.data(), rc, aovs ? info.data() : nullptr);
                 for (int i = 0; i < n; ++i) finish_pixel(x0 + i, y, c[size_t(i)], 1.f, &info[size_t(i)], rc);
             }
     }
@@ -278,8 +281,13 @@ public:
                 Color sum(0.f);
                 for (int s0 = 0; s0 < k * k; s0 += kRow) {
                     const int n = std::min(kRow, k * k - s0);
+                    std::array<Ray, kRow> rays;
+                    for (int i = 0; i < n; ++i) {
+                        const auto [sx, sy] = position(s0 + i);
+                        rays[size_t(i)] = m_camera.generate(sx, sy);
+                    }
                     std::array<Color, kRow> c;
-                    sample_row(n, [&](int i) { return position(s0 + i); }, c.data(), rc);
+                    trace_row(std::span<const Ray>(rays.data(), size_t(n)), c.data(), rc);
                     for (int i = 0; i < n; ++i) sum += c[size_t(i)];
                 }
                 finish_pixel(x, y, sum * float(1.0 / m_aa.spp), float(m_aa.spp), nullptr, rc);
@@ -297,7 +305,7 @@ public:
             for (int x0 = r.x0; x0 < cx1; x0 += kRow) {
                 const int n = std::min(kRow, cx1 - x0);
                 std::array<Color, kRow> c;
-                sample_row(n, [&](int i) { return std::pair(double(x0 + i), double(y)); }, c.data(), rc);
+                sample_row(n, double(x0), double(y), c.data(), rc);
                 for (int i = 0; i < n; ++i) m_lattice[lattice_index(x0 + i, y)] = c[size_t(i)];
             }
     }
