@@ -250,11 +250,12 @@ public:
     /// center: one ray through each pixel centre (it also gives the AOVs), rows of a tile in batches.
     void center_tile(const Rect& r, RayCounters& rc) {
         const bool aovs = m_film.aovs.needs_first_hit();
+        std::array<Color, kRow> c;
+        std::array<PrimaryInfo, kRow> info;  // read by finish_pixel only when AOVs are on
         for (int y = r.y0; y < r.y1; ++y)
             for (int x0 = r.x0; x0 < r.x1; x0 += kRow) {
                 const int n = std::min(kRow, r.x1 - x0);
-                std::array<Color, kRow> c;
-                std::array<PrimaryInfo, kRow> info;
+                if (aovs) info.fill(PrimaryInfo{});
                 sample_row(n, x0 + 0.5, y + 0.5, c.data(), rc, aovs ? info.data() : nullptr);
                 for (int i = 0; i < n; ++i) finish_pixel(x0 + i, y, c[size_t(i)], 1.f, &info[size_t(i)], rc);
             }
