@@ -50,6 +50,7 @@
 
 #include <time.h>
 
+#include "apps/whitted/bench_timing.h"
 #include "apps/whitted/command.h"
 #include "apps/whitted/ray_recording.h"
 #include "importers/scene_loader.h"
@@ -72,11 +73,7 @@ using Clock = std::chrono::steady_clock;
 bool g_cpu_clock = false;
 
 double clock_now() {
-    if (g_cpu_clock) {
-        timespec ts{};
-        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-        return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-    }
+    if (g_cpu_clock) return process_cpu_seconds();
     return std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
 }
 
@@ -103,10 +100,7 @@ std::vector<std::string> default_scenes() {
 }
 
 /// The 1-minute load average (the machine is shared: every figure is printed next to it).
-double load_average() {
-    double l[1] = {0.0};
-    return getloadavg(l, 1) == 1 ? l[0] : -1.0;
-}
+double load_average() { return load_average_1min(); }
 
 double median(std::vector<double> v) {
     if (v.empty()) return 0.0;
