@@ -46,4 +46,11 @@ inline FresnelWeights schlick_weights(const Color& ks, const Color& kr, const Co
     return w;
 }
 
+/// The weights of the reflected and refracted rays at a hit: kr and kt as given, or Schlick-weighted
+/// (schlick_weights) with the Fresnel option. The integrator and the stress suite's energy bound
+/// both take them from here.
+inline FresnelWeights secondary_weights(const Color& ks, const Color& kr, const Color& kt, float cos_v, bool fresnel) {
+    return fresnel ? schlick_weights(ks, kr, kt, cos_v) : FresnelWeights{kr, kt};
+}
+
 }  // namespace whitted

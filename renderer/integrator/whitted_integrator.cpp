@@ -509,14 +509,9 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
         // Recursive rays: Ks R + Kt T.
         if constexpr (K.mirror || K.transmission) {
             if (depth < m_settings.max_depth) {
-                Color kr = c.kr, kt = c.kt;
-                const float cos_v = std::clamp(dot(N, V), 0.f, 1.f);
-                if (m_settings.fresnel) {
-                    // Schlick: the mirror weight follows F(theta) and transmission takes what is left.
-                    const FresnelWeights fw = schlick_weights(c.ks, c.kr, c.kt, cos_v);
-                    kr = fw.kr;
-                    kt = fw.kt;
-                }
+                // With --fresnel (Schlick) the mirror weight follows F(theta) and transmission takes
+                // what is left.
+                auto [kr, kt] = secondary_weights(c.ks, c.kr, c.kt, std::clamp(dot(N, V), 0.f, 1.f), m_settings.fresnel);
                 // Hall & Greenberg (1983): a branch whose accumulated weight falls below min_weight
                 // cannot change the pixel visibly; it is not traced.
                 if constexpr (K.transmission) {

@@ -768,14 +768,8 @@ public:
             if (!is_black(c.kd) || !is_black(c.ks))
                 for (const Light& light : scene.lights) result += sample_light(light, sp.p).intensity * (c.kd + c.ks);
             if (depth < m_s.max_depth) {
-                Color kr = c.kr, kt = c.kt;
-                const float cos_v = std::clamp(dot(N, V), 0.f, 1.f);
-                if (m_s.fresnel) {
-                    const FresnelWeights fw = schlick_weights(c.ks, c.kr, c.kt, cos_v);
-                    kr = fw.kr;
-                    kt = fw.kt;
-                }
-                const float wt = weight * max3(kt);
+                auto [kr, kt] = secondary_weights(c.ks, c.kr, c.kt, std::clamp(dot(N, V), 0.f, 1.f), m_s.fresnel);
+                const float wt = weight * max_component(kt);
                 if (!is_black(kt) && wt >= m_s.min_weight) {
                     Ray t;
                     t.org = offset_ray_origin(sp.p, -Ng);
@@ -790,7 +784,7 @@ public:
                     if (transmitted) result += kt * trace(t, RayKind::Refraction, depth + 1, secondary, wt);
                     else kr += kt;
                 }
-                const float wr = weight * max3(kr);
+                const float wr = weight * max_component(kr);
                 if (!is_black(kr) && wr >= m_s.min_weight) {
                     Vec3f R = reflect(V, N);
                     if (dot(R, Ng) <= 0.f) R = reflect(V, Ng);
@@ -819,7 +813,6 @@ public:
     }
 
 private:
-    static float max3(const Color& c) { return std::max(c.x, std::max(c.y, c.z)); }
     const SceneView& m_view;
     const Accelerator& m_accel;
     IntegratorSettings m_s;
