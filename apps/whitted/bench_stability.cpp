@@ -6,7 +6,6 @@
 // <out>/stability.csv (one measurement per row) and prints the tables of
 // docs/numerical-stability.md.
 #include <algorithm>
-#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -61,17 +60,6 @@ private:
 
 bool wanted(const BenchStabilityOptions& o, const char* section) {
     return o.sections == "all" || ("," + o.sections + ",").find(std::string(",") + section + ",") != std::string::npos;
-}
-
-/// The offset before issue #7 (Wächter & Binder 2019 as published), for comparison.
-Vec3f previous_offset(const Vec3f& p, const Vec3f& n) {
-    Vec3f o;
-    for (int k = 0; k < 3; ++k) {
-        const int32_t of = int32_t(256.f * n[k]);
-        const float pi = std::bit_cast<float>(std::bit_cast<int32_t>(p[k]) + (p[k] < 0.f ? -of : of));
-        o[k] = std::fabs(p[k]) < 1.f / 32.f ? p[k] + n[k] / 65536.f : pi;
-    }
-    return o;
 }
 
 const double kScales[] = {1e-4, 1e-2, 1.0, 1e2, 1e4, 1e6};
@@ -134,7 +122,7 @@ void run_self_intersection(const BenchStabilityOptions& o, Csv& csv) {
                         c.translation = t;
                         c.points = o.points;
                         c.gap_ulps = gap;
-                        if (v.previous) c.offset = previous_offset;
+                        if (v.previous) c.offset = wachter_binder_2019;
                         if (v.offset_ulps > 0.f)
                             c.offset = [u = v.offset_ulps](const Vec3f& p, const Vec3f& n) { return offset_ray_origin(p, n, u); };
                         SelfIntersectionResult r = probe_self_intersection(c);

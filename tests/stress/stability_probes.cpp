@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -125,6 +126,16 @@ float ulp(float x) {
     x = std::fabs(x);
     if (!std::isfinite(x)) return x;
     return std::nextafter(x, kInfinity) - x;
+}
+
+Vec3f wachter_binder_2019(const Vec3f& p, const Vec3f& n) {
+    Vec3f o;
+    for (int k = 0; k < 3; ++k) {
+        const int32_t of = int32_t(256.f * n[k]);
+        const float pi = std::bit_cast<float>(std::bit_cast<int32_t>(p[k]) + (p[k] < 0.f ? -of : of));
+        o[k] = std::fabs(p[k]) < 1.f / 32.f ? p[k] + n[k] / 65536.f : pi;
+    }
+    return o;
 }
 
 float max_abs(const Vec3f& p) { return std::max(std::fabs(p.x), std::max(std::fabs(p.y), std::fabs(p.z))); }

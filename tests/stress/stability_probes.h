@@ -48,6 +48,10 @@ bool is_closed_mesh(const Mesh& mesh);
 /// How secondary-ray origins are moved off a surface: the renderer's offset_ray_origin by default.
 using OffsetFn = std::function<Vec3f(const Vec3f& p, const Vec3f& n)>;
 
+/// The offset before issue #7 (Wächter & Binder 2019 as published: 256 ulps of each coordinate,
+/// 1/65536 absolute below 1/32), kept to show the suite catches what it got wrong.
+Vec3f wachter_binder_2019(const Vec3f& p, const Vec3f& n);
+
 /// The surface A of the self-intersection probe.
 enum class ProbeSurface : uint8_t {
     MeshSphere,       ///< tessellated unit sphere (24 x 48), closed, placed by scale/translation

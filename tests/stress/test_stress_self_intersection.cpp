@@ -2,7 +2,6 @@
 // reference. Bounded for CI; `whitted bench stability` runs the same probes with more points.
 #include <gtest/gtest.h>
 
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -29,18 +28,6 @@ std::string label(const SelfIntersectionConfig& c) {
                           : c.smooth_normals                         ? "mesh (smooth normals)"
                                                                      : "mesh (flat)";
     return c.accel + " " + surface + " s=" + std::to_string(c.scale) + " t=" + std::to_string(c.translation);
-}
-
-/// The offset before issue #7 (Wächter & Binder 2019 as published: 256 ulps of each coordinate,
-/// 1/65536 absolute below 1/32), kept here to show the suite catches what it got wrong.
-Vec3f wachter_binder_2019(const Vec3f& p, const Vec3f& n) {
-    Vec3f o;
-    for (int k = 0; k < 3; ++k) {
-        const int32_t of = int32_t(256.f * n[k]);
-        const float pi = std::bit_cast<float>(std::bit_cast<int32_t>(p[k]) + (p[k] < 0.f ? -of : of));
-        o[k] = std::fabs(p[k]) < 1.f / 32.f ? p[k] + n[k] / 65536.f : pi;
-    }
-    return o;
 }
 
 // The offset kernel itself: at least kOffsetUlps ulp(max|p|) along n (rounded away from the
