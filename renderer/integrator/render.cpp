@@ -207,15 +207,17 @@ public:
             m_lattice.assign(size_t(film.width() + 1) * size_t(film.height() + 1), Color(0.f));
     }
 
-    /// One primary sample at image position (x, y): exposure-scaled radiance, never NaN/inf.
+    /// A camera ray's radiance as a sample: exposure-scaled, never NaN/inf (counted, set to 0).
+    Color exposed(const Color& radiance) {
+        const Color c = radiance * m_exposure;
+        if (is_finite(c)) return c;
+        ++m_nonfinite;
+        return Color(0.f);
+    }
+
+    /// One primary sample at image position (x, y).
     Color sample(double x, double y, RayCounters& rc, PrimaryInfo* info = nullptr) {
-        const Ray ray = m_camera.generate(x, y);
-        Color c = m_integrator.trace(ray, RayKind::Camera, 0, rc, info, m_cone) * m_exposure;
-        if (!is_finite(c)) {
-            ++m_nonfinite;
-            c = Color(0.f);
-        }
-        return c;
+        return exposed(m_integrator.trace(m_camera.generate(x, y), RayKind::Camera, 0, rc, info, m_cone));
     }
 
     /// Samples traced together by sample_row: a coherent row (the integrator's batch size).
@@ -228,14 +230,7 @@ public:
         const size_t n = rays.size();
         m_integrator.trace_camera(rays, std::span<Color>(out, n), rc, m_cone,
                                   info ? std::span<PrimaryInfo>(info, n) : std::span<PrimaryInfo>{});
-        for (size_t i = 0; i < n; ++i) {
-            Color c = out[i] * m_exposure;
-            if (!is_finite(c)) {
-                ++m_nonfinite;
-                c = Color(0.f);
-            }
-            out[i] = c;
-        }
+        for (size_t i = 0; i < n; ++i) out[i] = exposed(out[i]);
     }
 
     /// n <= kRow samples along an image row, at (x0 + i, y): generated as a row (bit for bit the
