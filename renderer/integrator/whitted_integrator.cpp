@@ -327,12 +327,17 @@ WhittedIntegrator::WhittedIntegrator(const SceneView& view, const Accelerator& a
 }
 
 template <KernelFeatures K>
+Color WhittedIntegrator::radiance_of(const Ray& ray, const Hit& hit, int depth, RayCounters& counters,
+                                     PrimaryInfo* primary, const RayCone& cone, float weight) const {
+    if (!hit.valid()) return m_settings.background;
+    return sanitize(shade<K>(ray, hit, depth, counters, primary, cone, weight));
+}
+
+template <KernelFeatures K>
 Color WhittedIntegrator::trace_kernel(const Ray& ray, RayKind kind, int depth, RayCounters& counters,
                                       PrimaryInfo* primary, const RayCone& cone, float weight) const {
     count(counters, kind);
-    const Hit hit = m_accel.intersect(ray, kind);
-    if (!hit.valid()) return m_settings.background;
-    return sanitize(shade<K>(ray, hit, depth, counters, primary, cone, weight));
+    return radiance_of<K>(ray, m_accel.intersect(ray, kind), depth, counters, primary, cone, weight);
 }
 
 void WhittedIntegrator::trace_camera(std::span<const Ray> rays, std::span<Color> radiance, RayCounters& counters,
@@ -361,9 +366,8 @@ void WhittedIntegrator::trace_camera_kernel(std::span<const Ray> rays, std::span
             counters.camera += n;
             for (size_t j = 0; j < n; ++j) {
                 const size_t i = begin + j;
-                radiance[i] = hits[j].valid() ? sanitize(shade<K>(rays[i], hits[j], 0, counters,
-                                                                   primary.empty() ? nullptr : &primary[i], cone, 1.f))
-                                              : m_settings.background;
+                radiance[i] = radiance_of<K>(rays[i], hits[j], 0, counters, primary.empty() ? nullptr : &primary[i],
+                                             cone, 1.f);
             }
         }
     }

@@ -132,6 +132,11 @@ private:
     template <KernelFeatures K>
     Color trace_kernel(const Ray& ray, RayKind kind, int depth, RayCounters& counters, PrimaryInfo* primary,
                        const RayCone& cone, float weight) const;
+    /// Radiance along `ray` given its closest hit (the background for a miss), sanitised: what
+    /// trace_kernel and trace_camera_kernel return once the accelerator has answered.
+    template <KernelFeatures K>
+    Color radiance_of(const Ray& ray, const Hit& hit, int depth, RayCounters& counters, PrimaryInfo* primary,
+                      const RayCone& cone, float weight) const;
     using CameraFn = void (WhittedIntegrator::*)(std::span<const Ray>, std::span<Color>, RayCounters&, const RayCone&,
                                                   std::span<PrimaryInfo>) const;
     template <KernelFeatures K>
