@@ -25,9 +25,10 @@ public:
     /// Ray through image position (x, y) in pixels, (0, 0) = top-left corner of the image,
     /// (width, height) = bottom-right; pixel centres are at +0.5. Direction is unit length.
     Ray generate(double x, double y) const;
-    /// A row of rays: rays[i] = generate(x0 + i * dx, y), bit for bit. Generating a row before
-    /// tracing it lets the divisions and square roots of neighbouring rays overlap in the pipeline
-    /// (one ray's generate() waits on its own: about 9% of an opaque one-thread render's samples).
+    /// A row of rays: rays[i] = generate(x0 + i * dx, y), bit for bit. Perspective rows are
+    /// computed in blocks of packed double arithmetic (AVX2 when the CPU has it), so the divisions
+    /// and square roots of neighbouring rays share instructions (one ray's generate() waits on its
+    /// own: about 9% of an opaque one-thread render's samples).
     void generate_row(double x0, double dx, double y, std::span<Ray> rays) const;
     /// Footprint of one pixel as a ray cone: perspective cameras spread by the angle one pixel
     /// subtends at the image centre (2 tan(yfov/2) / height), orthographic ones have a constant
