@@ -163,20 +163,7 @@ SceneAnalysis analyze_scene(const Scene& scene, const MappingOptions& mapping) {
     SceneFeatures& s = a.features;
     for (MaterialFeatures& f : a.materials) {
         f.varying = f.textured || f.vertex_colors;
-        if (!f.used) continue;
-        s.diffuse |= f.diffuse;
-        s.highlight |= f.highlight;
-        s.mirror |= f.mirror;
-        s.transmission |= f.transmission;
-        s.emissive |= f.emissive;
-        s.unlit |= f.unlit;
-        s.textured |= f.textured;
-        s.vertex_colors |= f.vertex_colors;
-        s.alpha_mask |= f.alpha_mask;
-        s.alpha_blend |= f.alpha_blend;
-        s.volume |= f.volume;
-        s.single_sided |= f.single_sided;
-        s.varying |= f.varying;
+        if (f.used) s |= f;
     }
 
     // Light reach per object: instances (transformed mesh bounds), spheres, planes.

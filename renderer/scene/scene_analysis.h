@@ -22,9 +22,9 @@
 
 namespace whitted {
 
-/// What one material can produce anywhere on the surfaces that use it.
-struct MaterialFeatures {
-    bool used = false;            ///< some mesh, sphere or plane uses it
+/// The feature flags a material has and a scene ORs together (operator|=, kept next to the
+/// flags so that a new flag is ORed where it is declared).
+struct FeatureFlags {
     bool diffuse = false;         ///< kd may be > 0
     bool highlight = false;       ///< ks may be > 0 (Phong-Blinn highlight)
     bool mirror = false;          ///< kr may be > 0: reflection rays
@@ -38,17 +38,36 @@ struct MaterialFeatures {
     bool volume = false;          ///< Beer-Lambert absorption inside (KHR_materials_volume)
     bool single_sided = false;    ///< back faces culled for camera rays (filters in traversal)
     /// Coefficients depend on the point (textures or vertex colors): evaluated per hit. Otherwise
-    /// `constant` holds them for every point.
+    /// MaterialFeatures::constant holds them for every point.
     bool varying = false;
+
+    FeatureFlags& operator|=(const FeatureFlags& o) {
+        diffuse |= o.diffuse;
+        highlight |= o.highlight;
+        mirror |= o.mirror;
+        transmission |= o.transmission;
+        emissive |= o.emissive;
+        unlit |= o.unlit;
+        textured |= o.textured;
+        vertex_colors |= o.vertex_colors;
+        alpha_mask |= o.alpha_mask;
+        alpha_blend |= o.alpha_blend;
+        volume |= o.volume;
+        single_sided |= o.single_sided;
+        varying |= o.varying;
+        return *this;
+    }
+};
+
+/// What one material can produce anywhere on the surfaces that use it.
+struct MaterialFeatures : FeatureFlags {
+    bool used = false;            ///< some mesh, sphere or plane uses it
     WhittedCoeffs constant;       ///< the coefficients when !varying (also: at the factors alone)
     float constant_alpha = 1.f;   ///< coverage alpha when !varying (base colour alpha, clamped)
 };
 
 /// The OR of MaterialFeatures over the used materials, and what the geometry carries.
-struct SceneFeatures {
-    bool diffuse = false, highlight = false, mirror = false, transmission = false, emissive = false,
-         unlit = false, textured = false, vertex_colors = false, alpha_mask = false, alpha_blend = false,
-         volume = false, single_sided = false, varying = false;
+struct SceneFeatures : FeatureFlags {
     bool uv = false;              ///< some mesh has TEXCOORD_0/1 (or spheres/planes: always parametrised)
     bool tangents = false;        ///< some mesh has tangents
     /// Secondary rays can exist: mirrors, transmission or alpha blend.
