@@ -12,6 +12,7 @@
 
 #include "renderer/core/error.h"
 #include "renderer/core/ray_offset.h"
+#include "renderer/integrator/shading_frame.h"
 #include "shading/light_sample.h"
 #include "shading/optics.h"
 
@@ -384,14 +385,9 @@ void WhittedIntegrator::probe(const Ray& ray, RayCounters& counters, PrimaryInfo
     if (!hit.valid()) return;
     const SurfacePoint sp = m_view.surface(ray, hit);
     const WhittedCoeffs c = m_view.coefficients(sp);
-    // The same orientation rules as shade().
-    const Vec3f V = -ray.dir;
-    const bool front = dot(sp.ng, V) >= 0.f;
-    Vec3f N = front ? sp.ns : -sp.ns;
-    if (dot(N, V) <= 0.f) N = front ? sp.ng : -sp.ng;
     primary.hit = true;
     primary.depth = hit.t;
-    primary.normal = N;
+    primary.normal = shading_frame(sp, ray.dir).N;  // as shade() reports it
     primary.albedo = c.kd + c.kr + c.kt;
     primary.prim = hit.prim;
     primary.inst = hit.inst;
@@ -433,13 +429,9 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
     // widen (convex mirrors) or narrow it; it is ignored (flat-surface propagation).
     const RayCone secondary{cone.width_at(hit.t), cone.spread};
 
-    // Orient the frame toward the viewer. `front` also says whether a ray enters the medium
-    // (hits the front face by winding) or leaves it: decided on the geometric normal.
-    const Vec3f V = -ray.dir;
-    const bool front = dot(sp.ng, V) >= 0.f;
-    const Vec3f Ng = front ? sp.ng : -sp.ng;
-    Vec3f N = front ? sp.ns : -sp.ns;
-    if (dot(N, V) <= 0.f) N = Ng;  // shading normal facing away from the viewer: fall back
+    // Orient the frame toward the viewer; `front` also says whether a ray enters the medium or
+    // leaves it (shading_frame.h).
+    const auto [V, front, Ng, N] = shading_frame(sp, ray.dir);
 
     // Touching dielectrics (DielectricContacts): the medium on the far side of this surface may
     // begin right here. `other` is that medium, entered when this one is left and left when this
