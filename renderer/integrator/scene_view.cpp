@@ -1,5 +1,6 @@
 #include "renderer/integrator/scene_view.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "shading/texture_sampling.h"
@@ -20,6 +21,9 @@ Vec3f xf_normal(const float* n, const Vec3f& v) {
     return {n[0] * v.x + n[1] * v.y + n[2] * v.z, n[3] * v.x + n[4] * v.y + n[5] * v.z,
             n[6] * v.x + n[7] * v.y + n[8] * v.z};
 }
+
+/// Largest absolute coordinate.
+double max_abs(const Vec3d& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
 
 template <typename T>
 T interpolate(const std::vector<T>& a, uint32_t i0, uint32_t i1, uint32_t i2, float u, float v) {
@@ -133,6 +137,10 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
     const double ud = u, vd = v, wd = 1.0 - ud - vd;
     sp.p = Vec3f(w0 * wd + w1 * ud + w2 * vd);
     sp.p_shadow = sp.p;
+    // The triangle tests (Woop et al. 2013 in float, Embree's) form v_i - o: their t error is a
+    // few ulps of the vertices' coordinates, which on a large triangle near the world origin
+    // dwarf ulp(|p|) (ray_offset.h).
+    sp.offset_scale = float(std::max({max_abs(w0), max_abs(w1), max_abs(w2)}));
     const Vec3f p0(w0), p1(w1), p2(w2);
     if (!mesh.normals.empty()) {
         // Shadow terminator (Hanika, "Hacking the Shadow Terminator", Ray Tracing Gems II, 2021):
@@ -218,6 +226,10 @@ SurfacePoint SceneView::sphere_surface(const Ray& ray, const Hit& hit, const Ray
     n = len > 0.0 ? n / len : -d;
     sp.p = Vec3f(sphere.center + n * sphere.radius);
     sp.p_shadow = sp.p;
+    // sphere_roots forms o - c in double and solves the quadratic in float in units of the radius:
+    // its t error near the surface is a few ulps of r, whatever |c| (a large sphere grazing the
+    // world origin has hit points much smaller than r).
+    sp.offset_scale = float(sphere.radius);
     sp.ng = sp.ns = normalize(Vec3f(n));
     if constexpr (!kAttributes) return sp;
     // Longitude about +Y and colatitude from the +Y pole (scene.h: Sphere).
@@ -249,6 +261,10 @@ SurfacePoint SceneView::plane_surface(const Ray& ray, const Hit& hit, const RayC
     p = p - plane.normal * dot(plane.normal, p - plane.point);
     sp.p = Vec3f(p);
     sp.p_shadow = sp.p;
+    // intersect_plane computes dot(normal, point - o) in double: its error, at most ~8 double ulps
+    // of max|point|, stays below a quarter of the 4-ulp float offset of 2^-26 max|point|, so only a
+    // plane defined by a point ~1e8 times farther out than the hit moves the unit.
+    sp.offset_scale = float(max_abs(plane.point)) * 0x1p-26f;
     sp.ng = sp.ns = Vec3f(plane.normal);
     if constexpr (!kAttributes) return sp;
     const Vec3d rel = p - plane.point;

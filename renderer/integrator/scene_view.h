@@ -29,6 +29,11 @@ struct SurfacePoint {
     Vec3f p;                    ///< position, interpolated from the triangle's world-space vertices
     Vec3f p_shadow;             ///< shadow-ray origin on the front side: p lifted onto the smooth
                                 ///< surface the vertex normals describe (Hanika 2021), = p when flat
+    float offset_scale = 0.f;   ///< magnitude of the hit primitive's coordinates, the scale of its
+                                ///< intersection test's rounding: ray origins leave p by ulps of
+                                ///< max(max|p|, offset_scale) (ray_offset.h). Triangles: the largest
+                                ///< |coordinate| of the world-space vertices; spheres: the radius;
+                                ///< planes: 2^-26 max|point| (see SceneView::surface)
     Vec3f ng;                   ///< unit geometric normal (front side by winding)
     Vec3f ns;                   ///< unit shading normal (interpolated, normal-mapped), front side
     Vec2f uv[2];                ///< TEXCOORD_0/1 (0 when absent)

@@ -100,10 +100,11 @@ public:
     /// True when object `o` (object_index) may touch another non-thin dielectric.
     bool candidate(uint32_t o) const { return m_candidate[o] != 0; }
 
-    /// The front face of another non-thin dielectric within guaranteed_gap(p) of p, found by a
-    /// probe from just inside the surface hit along its outward unit normal.
-    std::optional<Contact> at(const Vec3f& p, const Vec3f& outward) const {
-        const float reach = guaranteed_gap(p);
+    /// The front face of another non-thin dielectric within guaranteed_gap(p, scale) of p (scale:
+    /// the surface hit's SurfacePoint::offset_scale, the unit secondary rays leave it by), found by
+    /// a probe from just inside the surface hit along its outward unit normal.
+    std::optional<Contact> at(const Vec3f& p, float scale, const Vec3f& outward) const {
+        const float reach = guaranteed_gap(p, scale);
         Contact c;
         c.probe.org = p - outward * reach;
         c.probe.dir = outward;
@@ -398,11 +399,11 @@ std::optional<WhittedIntegrator::OtherMedium> WhittedIntegrator::other_medium(co
     const Scene& scene = m_view.scene();
     if (!m_contacts->candidate(object_index(scene, hit.geom, hit.inst))) return std::nullopt;
     ++counters.contact_probe;
-    const auto contact = m_contacts->at(sp.p, sp.ng);  // along the outward normal of the surface hit
+    const auto contact = m_contacts->at(sp.p, sp.offset_scale, sp.ng);  // along the outward normal of the surface hit
     if (!contact) return std::nullopt;
     const MaterialFeatures& mf = m_view.analysis().materials[scene.geom_material(contact->hit.geom)];
     const SurfacePoint so = m_view.surface(contact->probe, contact->hit);
-    return OtherMedium{mf.varying ? m_view.coefficients(so) : mf.constant, so.p};
+    return OtherMedium{mf.varying ? m_view.coefficients(so) : mf.constant, so.p, so.offset_scale};
 }
 
 // The kernel. Every `if constexpr` below removes work a scene cannot need; the operations that
@@ -457,7 +458,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
     if (!unlit) {
         // Local model: I = Ia Ka + sum_i Is_i fat_i s_i (kd (N.L) + ks (N.H)^n).
         result += m_settings.ambient * c.ka;
-        const Vec3f shadow_org = offset_ray_origin(front ? sp.p_shadow : sp.p, Ng);
+        const Vec3f shadow_org = offset_ray_origin(front ? sp.p_shadow : sp.p, sp.offset_scale, Ng);
         const bool diffuse_or_specular = !is_black(c.kd) || !is_black(c.ks);
         auto add_light = [&](const Light& light) {
             LightSample ls = sample_light(light, sp.p);
@@ -522,7 +523,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                     if (!is_black(kt) && wt < m_settings.min_weight) ++counters.secondary_skipped_cutoff;
                     if (!is_black(kt) && wt >= m_settings.min_weight) {
                         Ray t;
-                        t.org = offset_ray_origin(sp.p, -Ng);
+                        t.org = offset_ray_origin(sp.p, sp.offset_scale, -Ng);
                         bool transmitted = true;
                         if (c.thin) {
                             t.dir = ray.dir;  // thin-walled: straight through
@@ -533,7 +534,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                                 // (no total internal reflection in a gap of zero width), and the ray
                                 // starts past both surfaces.
                                 eta *= front ? other->c.ior : 1.f / other->c.ior;
-                                const Vec3f past_other = offset_ray_origin(other->p, -Ng);
+                                const Vec3f past_other = offset_ray_origin(other->p, std::max(sp.offset_scale, other->offset_scale), -Ng);
                                 if (dot(past_other - t.org, Ng) < 0.f) t.org = past_other;
                             }
                             auto dir = refract(ray.dir, N, eta);
@@ -554,7 +555,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                     Vec3f R = reflect(V, N);
                     if (dot(R, Ng) <= 0.f) R = reflect(V, Ng);
                     Ray r;
-                    r.org = offset_ray_origin(sp.p, Ng);
+                    r.org = offset_ray_origin(sp.p, sp.offset_scale, Ng);
                     r.dir = normalize(R);
                     result += kr * trace_kernel<K>(r, RayKind::Reflection, depth + 1, counters, nullptr, secondary, wr);
                 }
@@ -576,7 +577,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
             else alpha = std::clamp(m_view.material_inputs(mat, sp).base_color.w, 0.f, 1.f);
             if (alpha < 1.f) {
                 Ray behind;
-                behind.org = offset_ray_origin(sp.p, -Ng);
+                behind.org = offset_ray_origin(sp.p, sp.offset_scale, -Ng);
                 behind.dir = ray.dir;
                 // Below min_weight the branch behind is dropped (contributes 0) like the others.
                 const float wb = weight * (1.f - alpha);

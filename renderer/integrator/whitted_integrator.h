@@ -154,6 +154,7 @@ private:
     struct OtherMedium {
         WhittedCoeffs c;
         Vec3f p;
+        float offset_scale;  ///< SurfacePoint::offset_scale of its face
     };
     /// Looks for it at a hit on a non-thin dielectric (out of line, off the kernels' hot path).
     std::optional<OtherMedium> other_medium(const Hit& hit, const SurfacePoint& sp, RayCounters& counters) const;

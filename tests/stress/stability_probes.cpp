@@ -128,7 +128,7 @@ float ulp(float x) {
     return std::nextafter(x, kInfinity) - x;
 }
 
-Vec3f wachter_binder_2019(const Vec3f& p, const Vec3f& n) {
+Vec3f wachter_binder_2019(const Vec3f& p, float, const Vec3f& n) {
     Vec3f o;
     for (int k = 0; k < 3; ++k) {
         const int32_t of = int32_t(256.f * n[k]);
@@ -256,10 +256,16 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
     const bool analytic = cfg.surface == ProbeSurface::AnalyticSphere;
     const double translation = quad ? 0.0 : cfg.translation;
     const Vec3d centre = kTranslationDir * translation;
-    // Gap: gap_ulps ulps of the largest coordinate any point of A can have, divided by the
+    // Gap: gap_ulps ulps of the largest coordinate any point or vertex of A can have (at least the
+    // offset unit ulp(max(max|p|, offset_scale)) of every point, ray_offset.h), divided by the
     // smallest distance of a facet plane from the centre, so every neighbour facet lies at least
-    // gap_ulps ulp(max|p|) away from its counterpart on A.
-    const float bound = float(std::max({std::fabs(centre.x), std::fabs(centre.y), std::fabs(centre.z)}) + s);
+    // gap_ulps offset units away from its counterpart on A. The quad's corners reach beyond s.
+    float bound = float(std::max({std::fabs(centre.x), std::fabs(centre.y), std::fabs(centre.z)}) + s);
+    if (quad)
+        for (const Vec3d corner : {Vec3d{-1, -1, 0}, Vec3d{1, -1, 0}, Vec3d{1, 1, 0}, Vec3d{-1, 1, 0}}) {
+            const Vec3d w = placement(s, 0.0).apply_point(corner);
+            bound = std::max(bound, float(std::max({std::fabs(w.x), std::fabs(w.y), std::fabs(w.z)})));
+        }
     const double gap = cfg.gap_ulps * double(ulp(bound));
     const int rings = 24, segments = 48;
     const double h_min = analytic || quad ? 1.0 : std::cos(kPiD / rings) * std::cos(kPiD / segments);
@@ -301,8 +307,8 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
     ProbeFilter filter(scene);
     const SceneView view(scene, MappingOptions{});
     const auto accel = create_accelerator(cfg.accel, scene, filter, AccelConfig{cfg.robust, 0});
-    const OffsetFn offset = cfg.offset ? cfg.offset : OffsetFn([](const Vec3f& p, const Vec3f& n) {
-        return offset_ray_origin(p, n);
+    const OffsetFn offset = cfg.offset ? cfg.offset : OffsetFn([](const Vec3f& p, float scale, const Vec3f& n) {
+        return offset_ray_origin(p, scale, n);
     });
 
     // Signed distance of x from the exact surface of A (positive outside), in double.
@@ -384,6 +390,7 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
         const bool front = dot(sp.ng, V) >= 0.f;
         const Vec3f Ng = front ? sp.ng : -sp.ng;
         const double u_p = double(ulp(max_abs(sp.p)));
+        const double u_offset = double(ulp(std::max(max_abs(sp.p), sp.offset_scale)));  // ray_offset.h's unit
         const Vec3d n_exact = exact_normal(Vec3d(sp.p), hit);
         res.point_error_ulps.push_back(std::fabs(surface_distance(Vec3d(sp.p), hit)) / u_p);
         res.normal_error_rad.push_back(angle_between(Vec3d(sp.ng), n_exact));
@@ -391,8 +398,8 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
         for (int kind = 0; kind < 3; ++kind) {
             const bool inward = kind == 1;
             const Vec3f base = kind == 2 && front ? sp.p_shadow : sp.p;
-            const Vec3f org = offset(base, inward ? -Ng : Ng);
-            const double dist = surface_distance(Vec3d(org), hit) / u_p * (inward ? -1.0 : 1.0);
+            const Vec3f org = offset(base, sp.offset_scale, inward ? -Ng : Ng);
+            const double dist = surface_distance(Vec3d(org), hit) / u_offset * (inward ? -1.0 : 1.0);
             if (kind < 2 || !cfg.smooth_normals) {  // lifted shadow origins are not offsets
                 res.max_offset_ulps = std::max(res.max_offset_ulps, std::fabs(dist));
                 res.min_offset_ulps = std::min(res.min_offset_ulps, dist);
@@ -783,7 +790,7 @@ public:
                 const float wt = weight * max_component(kt);
                 if (!is_black(kt) && wt >= m_s.min_weight) {
                     Ray t;
-                    t.org = offset_ray_origin(sp.p, -Ng);
+                    t.org = offset_ray_origin(sp.p, sp.offset_scale, -Ng);
                     bool transmitted = true;
                     if (c.thin) {
                         t.dir = ray.dir;
@@ -800,7 +807,7 @@ public:
                     Vec3f R = reflect(V, N);
                     if (dot(R, Ng) <= 0.f) R = reflect(V, Ng);
                     Ray r;
-                    r.org = offset_ray_origin(sp.p, Ng);
+                    r.org = offset_ray_origin(sp.p, sp.offset_scale, Ng);
                     r.dir = normalize(R);
                     result += kr * trace(r, RayKind::Reflection, depth + 1, secondary, wr);
                 }
@@ -812,7 +819,7 @@ public:
             const float alpha = std::clamp(m_view.material_inputs(mat, sp).base_color.w, 0.f, 1.f);
             if (alpha < 1.f) {
                 Ray behind;
-                behind.org = offset_ray_origin(sp.p, -Ng);
+                behind.org = offset_ray_origin(sp.p, sp.offset_scale, -Ng);
                 behind.dir = ray.dir;
                 const Color b = depth < m_s.max_depth
                                     ? trace(behind, RayKind::Refraction, depth + 1, secondary, weight * (1.f - alpha))

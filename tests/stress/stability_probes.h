@@ -45,12 +45,14 @@ bool is_closed_mesh(const Mesh& mesh);
 // ---------------------------------------------------------------------------------------------
 // 1. Self-intersection at any scale
 
-/// How secondary-ray origins are moved off a surface: the renderer's offset_ray_origin by default.
-using OffsetFn = std::function<Vec3f(const Vec3f& p, const Vec3f& n)>;
+/// How secondary-ray origins are moved off a surface (p, SurfacePoint::offset_scale, unit normal):
+/// the renderer's offset_ray_origin by default.
+using OffsetFn = std::function<Vec3f(const Vec3f& p, float scale, const Vec3f& n)>;
 
 /// The offset before issue #7 (Wächter & Binder 2019 as published: 256 ulps of each coordinate,
-/// 1/65536 absolute below 1/32), kept to show the suite catches what it got wrong.
-Vec3f wachter_binder_2019(const Vec3f& p, const Vec3f& n);
+/// 1/65536 absolute below 1/32), kept to show the suite catches what it got wrong. It knows only
+/// the point: `scale` is ignored.
+Vec3f wachter_binder_2019(const Vec3f& p, float scale, const Vec3f& n);
 
 /// The surface A of the self-intersection probe.
 enum class ProbeSurface : uint8_t {
@@ -70,7 +72,8 @@ struct SelfIntersectionConfig {
     double translation = 0.0;         ///< distance of its centre from the world origin
     size_t points = 2000;             ///< surface points (each hit by a camera ray)
     int directions = 8;               ///< secondary directions per point and ray kind
-    double gap_ulps = 4.0;            ///< neighbour surfaces this many ulp(max|p|) away (at least)
+    double gap_ulps = 4.0;            ///< neighbour surfaces this many offset units away (at least):
+                                      ///< ulp of the largest coordinate of A (ray_offset.h)
     double neighbour_min_cos = 1e-3;  ///< neighbours are judged for rays at least this far from grazing
     uint64_t seed = 1;
     OffsetFn offset;                  ///< empty = offset_ray_origin
@@ -91,7 +94,8 @@ struct SelfIntersectionResult {
     uint64_t neighbour_unchecked = 0; ///< rays below neighbour_min_cos: only self-hits judged
     uint64_t far_side_ties = 0;       ///< inward rays that reached A's far side just behind C
     uint64_t edge_exits = 0;          ///< inward rays leaving through an adjacent facet (exact geometry agrees)
-    double max_offset_ulps = 0;       ///< largest distance of an origin from its surface, ulp(max|p|)
+    double max_offset_ulps = 0;       ///< largest distance of an origin from its surface, in offset
+                                      ///< units ulp(max(max|p|, SurfacePoint::offset_scale))
     double min_offset_ulps = 0;       ///< smallest (signed, on the correct side > 0)
     std::vector<double> point_error_ulps;  ///< |SceneView p - exact surface|, ulp(max|p|), per point
     std::vector<double> normal_error_rad;  ///< angle between SceneView's Ng and the exact normal
@@ -99,7 +103,7 @@ struct SelfIntersectionResult {
 };
 
 /// Surface A (tessellated unit sphere or analytic sphere) with neighbour surfaces B (outside,
-/// scale 1 + d) and C (inside, scale 1 - d) at a gap of at most gap_ulps ulp(max|p|); random
+/// scale 1 + d) and C (inside, scale 1 - d) at a gap of at least gap_ulps offset units; random
 /// points of A found by camera rays; from each, reflection (outward), refraction (inward) and
 /// shadow (outward, from SurfacePoint::p_shadow) rays leave exactly as the integrator spawns them.
 /// A hit on A is a self-intersection; an outward ray must hit B from inside, an inward one C from

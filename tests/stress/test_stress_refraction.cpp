@@ -211,8 +211,12 @@ TEST(StressRefraction, TotalInternalReflectionAroundCriticalAngle) {
             const auto O = refract(I, Vec3f{0, 0, 1}, ior);  // inside the dense medium, leaving
             const std::string what = "ior " + std::to_string(ior) + " crit " + std::to_string(delta);
             // Float directions resolve the angle to ~1e-7 rad; the decision is exact beyond 1e-5.
-            if (delta <= -1e-5) EXPECT_TRUE(O.has_value()) << what;
-            if (delta >= 1e-5) EXPECT_FALSE(O.has_value()) << what;
+            if (delta <= -1e-5) {
+                EXPECT_TRUE(O.has_value()) << what;
+            }
+            if (delta >= 1e-5) {
+                EXPECT_FALSE(O.has_value()) << what;
+            }
             if (O) {
                 EXPECT_TRUE(is_finite(*O)) << what;
                 EXPECT_NEAR(length(*O), 1.f, 1e-5f) << what;
