@@ -147,17 +147,20 @@ std::unique_ptr<Accelerator> make_bvh(const char* name, const Scene& scene, cons
         [&](SpherePrims<T>&& s) { return SphereBlas(std::move(s), sphere_build); }, true);
 }
 
-/// `bvh` with N-wide mesh BVHs (float boxes); spheres and the top level keep the binary tree.
+/// `bvh` with N-wide mesh BVHs and an N-wide top level over instances (float boxes); the
+/// spheres keep the binary tree.
 template <int N>
 std::unique_ptr<Accelerator> make_wide_bvh(const Scene& scene, const SurfaceFilter& filter, const BvhBuildConfig& build,
                                            const WideBvhOptions& options) {
     using Blas = WideTriangleBvh<N>;
     using SphereBlas = PrimBvh<float, AabbVolume<float>, SpherePrims<float>>;
+    using Top = WideInstanceTree<N>;
     BvhBuildConfig sphere_build = build;
     sphere_build.max_leaf_size = std::min(build.max_leaf_size, 2);
-    return std::make_unique<TwoLevelAccelerator<float, Blas, SphereBlas>>(
+    return std::make_unique<TwoLevelAccelerator<float, Blas, SphereBlas, Top>>(
         "bvh", scene, filter, [&](const Mesh& m) { return Blas(TrianglePrims<float>(m), build, options); },
-        [&](SpherePrims<float>&& s) { return SphereBlas(std::move(s), sphere_build); }, true);
+        [&](SpherePrims<float>&& s) { return SphereBlas(std::move(s), sphere_build); },
+        [&](const std::vector<Bounds3f>& boxes) { return Top(boxes, options); });
 }
 
 template <typename T>

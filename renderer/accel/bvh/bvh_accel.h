@@ -53,8 +53,8 @@ struct BruteForceConfig {
 
 /// Two-level SAH BVH (BLAS per mesh, TLAS over instances, one more BVH over the spheres),
 /// watertight triangle test, stable sphere test (common/sphere.h). With float boxes and width 4
-/// or 8 the mesh BVHs are wide (SIMD node tests, triangles four at a time: wide_bvh.h); the
-/// top level and the sphere BVH stay binary.
+/// or 8 the mesh BVHs and the top level are wide (SIMD node tests, triangles four at a time:
+/// wide_bvh.h); the sphere BVH stays binary.
 std::unique_ptr<Accelerator> create_bvh_accelerator(const Scene& scene, const SurfaceFilter& filter,
                                                     const BvhConfig& config);
 /// Two-level BVH whose nodes are k-DOPs (Kay & Kajiya 1986), spheres likewise.

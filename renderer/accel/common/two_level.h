@@ -1,16 +1,28 @@
 // Two-level acceleration shared by the in-house backends, mirroring the Embree backend's layout:
 // one bottom-level structure (BLAS) per mesh in object space, and a top level over the instances
 // that transforms the ray into each instance's object space (t is unchanged by an affine map of
-// origin and direction). The top level is a SAH BVH over the instances' world boxes, or, for the
-// brute-force oracle, a plain loop. The scene's analytic spheres are one more structure of the
-// backend's own kind (SphereBlas, built over SpherePrims in world space), traced beside the top
-// level with the world-space ray; infinite planes are added outside (planes.h).
+// origin and direction). The top level (the `Top` parameter) is the binary SAH BVH of
+// bvh_tree.h over the instances' world boxes (BinaryInstanceTree; for the brute-force oracle a
+// plain loop), or `bvh`'s 8/4-wide tree (WideInstanceTree, bvh/wide_bvh.h). The scene's analytic
+// spheres are one more structure of the backend's own kind (SphereBlas, built over SpherePrims in
+// world space), traced beside the top level with the world-space ray; infinite planes are added
+// outside (planes.h).
 //
 // A BLAS type provides
 //   template <class Query> bool traverse(const Vec3<T>& org, const Vec3<T>& dir, T tnear, Query& q) const;
 //     reports every candidate hit in (tnear, q.tmax] to q.report(...) and returns true as soon
 //     as report() does;
-//   Bounds3<T> bounds() const; BlasStats stats() const.
+//   Bounds3<T> bounds() const; BlasStats stats() const;
+// and optionally
+//   template <class Query> bool traverse_prepared(const PreparedRay& r, Query& q) const;
+//     the same from the per-ray constants the top level hands to visit() (PreparedRay is the
+//     top level's type, e.g. WideRay<N>; constructible from (org, dir, tnear)): identity
+//     instances reuse the world ray's, transformed ones build their own.
+// A top level type provides
+//   template <class Query, class Visit> bool traverse(org, dir, tnear, Query& q, Visit&& visit) const;
+//     calls visit(i, prepared) for the instances i (numbered as the boxes it was built from)
+//     whose box the ray may enter before q.tmax, true (and stops) as soon as visit() does;
+//   size_t bytes() const; size_t nodes() const.
 #pragma once
 
 #include <tbb/parallel_for.h>
@@ -19,6 +31,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "renderer/accel/accelerator.h"
@@ -26,6 +39,7 @@
 #include "renderer/accel/common/geometry.h"
 #include "renderer/accel/common/primitives.h"
 #include "renderer/accel/common/queries.h"
+#include "renderer/accel/common/simd.h"
 #include "renderer/scene/scene.h"
 
 namespace whitted {
@@ -58,21 +72,79 @@ struct Affine {
     }
 };
 
+/// What a top level without per-ray constants of its own hands to visit(): the BLAS takes the
+/// ray as origin and direction.
+struct NoPreparedRay {};
+
+/// The instance level as the binary SAH tree of bvh_tree.h (one instance per leaf, slab-tested
+/// boxes), or, with `tree` false, a plain loop over the instances in order (the brute-force
+/// oracle).
+template <typename T>
+class BinaryInstanceTree {
+public:
+    BinaryInstanceTree() = default;
+    BinaryInstanceTree(const std::vector<Bounds3<T>>& boxes, bool tree) : m_count(uint32_t(boxes.size())) {
+        // One instance (the common single-mesh scene): its BLAS tests its own root boxes, so the
+        // top level's set-up and box test would only add cost.
+        if (!tree || boxes.size() < 2) return;
+        BvhBuildConfig top;
+        top.max_leaf_size = 1;
+        std::vector<BuildNode<T>> built = build_bvh(boxes, top, m_ids);
+        m_nodes.reserve(built.size());
+        for (const BuildNode<T>& n : built) m_nodes.push_back({AabbVolume<T>{n.box.lo, n.box.hi}, n.index, n.count});
+        m_extent = abs_extent(m_nodes[0].volume.lo, m_nodes[0].volume.hi);
+    }
+
+    template <class Query, class Visit>
+    bool traverse(const Vec3<T>& org, const Vec3<T>& dir, T tnear, Query& q, Visit&& visit) const {
+        if (m_nodes.empty()) {
+            for (uint32_t k = 0; k < m_count; ++k)
+                if (visit(k, NoPreparedRay{})) return true;
+            return false;
+        }
+        const SlabRay<T> slab(org, dir, m_extent);
+        bool stop = false;
+        traverse_bvh(m_nodes, slab, tnear, q.tmax, [&](uint32_t first, uint32_t count) {
+            for (uint32_t k = 0; k < count; ++k)
+                if (visit(m_ids[first + k], NoPreparedRay{})) return stop = true;
+            return false;
+        });
+        return stop;
+    }
+
+    size_t bytes() const { return m_nodes.size() * sizeof(m_nodes[0]) + m_ids.size() * sizeof(uint32_t); }
+    size_t nodes() const { return m_nodes.size(); }
+
+private:
+    std::vector<BvhNode<AabbVolume<T>>> m_nodes;  ///< empty: loop over all instances
+    std::vector<uint32_t> m_ids;                  ///< leaf slot -> instance
+    uint32_t m_count = 0;
+    T m_extent = 0;                               ///< largest absolute coordinate of the boxes (culling slack)
+};
+
 /// The accelerator built from one BLAS per mesh, a top level over instances and one structure
 /// over the scene's spheres.
-template <typename T, typename Blas, typename SphereBlas>
+template <typename T, typename Blas, typename SphereBlas, typename Top = BinaryInstanceTree<T>>
 class TwoLevelAccelerator final : public Accelerator {
 public:
     using Accelerator::intersect;  // the batch query: the default loop (no packet traversal here)
     using BlasBuilder = std::function<Blas(const Mesh&)>;
     using SphereBuilder = std::function<SphereBlas(SpherePrims<T>&&)>;
+    using TopBuilder = std::function<Top(const std::vector<Bounds3<T>>&)>;
 
-    /// Builds the BLASes in parallel over meshes (each build is deterministic), then the top
-    /// level and the sphere structure (when the scene has spheres). `bvh_top` false = loop over
-    /// all instances (the brute-force oracle).
+    /// With the binary top level: `bvh_top` false = loop over all instances (the brute-force
+    /// oracle).
     TwoLevelAccelerator(std::string name, const Scene& scene, const SurfaceFilter& filter, const BlasBuilder& build_blas,
                         const SphereBuilder& build_spheres, bool bvh_top)
-        : m_name(std::move(name)), m_scene(scene), m_filter(filter), m_bvh_top(bvh_top) {
+        : TwoLevelAccelerator(std::move(name), scene, filter, build_blas, build_spheres,
+                              [bvh_top](const std::vector<Bounds3<T>>& boxes) { return Top(boxes, bvh_top); }) {}
+
+    /// Builds the BLASes in parallel over meshes (each build is deterministic), then the top
+    /// level over the instances' world boxes and the sphere structure (when the scene has
+    /// spheres).
+    TwoLevelAccelerator(std::string name, const Scene& scene, const SurfaceFilter& filter, const BlasBuilder& build_blas,
+                        const SphereBuilder& build_spheres, const TopBuilder& build_top)
+        : m_name(std::move(name)), m_scene(scene), m_filter(filter) {
         const auto start = std::chrono::steady_clock::now();
         // Spheres: world space, each with its own geometry id and filter flags.
         SpherePrims<T> spheres(scene, filter);
@@ -93,13 +165,7 @@ public:
             m_instances.push_back(d);
             boxes.push_back(world_box(m_blas[inst.mesh]->bounds(), inst.world_from_object));
         }
-        if (m_bvh_top) {
-            BvhBuildConfig top;
-            top.max_leaf_size = 1;
-            std::vector<BuildNode<T>> built = build_bvh(boxes, top, m_top_ids);
-            m_top.reserve(built.size());
-            for (const BuildNode<T>& n : built) m_top.push_back({AabbVolume<T>{n.box.lo, n.box.hi}, n.index, n.count});
-        }
+        m_top = build_top(boxes);
         m_stats.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         // Size figures: the BLASes, the top level and the per-instance data.
         double sah_weighted = 0.0;
@@ -120,8 +186,8 @@ public:
             m_stats.nodes += s.nodes;
             m_stats.references += s.references;
         }
-        m_stats.bytes += m_top.size() * sizeof(m_top[0]) + m_top_ids.size() * 4 + m_instances.size() * sizeof(InstanceData);
-        m_stats.nodes += m_top.size();
+        m_stats.bytes += m_top.bytes() + m_instances.size() * sizeof(InstanceData);
+        m_stats.nodes += m_top.nodes();
     }
 
     Hit intersect(const Ray& ray, RayKind kind) const override {
@@ -186,37 +252,32 @@ private:
         const T tnear = T(ray.tnear);
         // Spheres first (world space; they set q.ctx per sphere).
         if (m_spheres && m_spheres->traverse(org, dir, tnear, q)) return;
-        // Enter one instance: object-space ray, then its BLAS.
-        auto visit = [&](const InstanceData& d) -> bool {
+        // Enter one instance: object-space ray, then its BLAS. A BLAS that takes the top level's
+        // per-ray constants gets the world ray's when the instance's transform is the identity.
+        auto visit = [&](uint32_t k, const auto& prepared) WHITTED_ALWAYS_INLINE_LAMBDA -> bool {
+            const InstanceData& d = m_instances[k];
             q.ctx = InstanceContext{d.mesh, d.inst, d.flags};
             const Blas& blas = *m_blas[d.mesh];
-            if (d.object_from_world.identity) return blas.traverse(org, dir, tnear, q);
-            return blas.traverse(d.object_from_world.point(org), d.object_from_world.vector(dir), tnear, q);
+            using Prepared = std::decay_t<decltype(prepared)>;
+            if constexpr (requires { blas.traverse_prepared(prepared, q); }) {
+                if (d.object_from_world.identity) return blas.traverse_prepared(prepared, q);
+                const Prepared object(d.object_from_world.point(org), d.object_from_world.vector(dir), tnear);
+                return blas.traverse_prepared(object, q);
+            } else {
+                if (d.object_from_world.identity) return blas.traverse(org, dir, tnear, q);
+                return blas.traverse(d.object_from_world.point(org), d.object_from_world.vector(dir), tnear, q);
+            }
         };
-        // One instance (the common single-mesh scene): its BLAS tests its own root boxes, so the
-        // top level's set-up and box test would only add cost.
-        if (!m_bvh_top || m_instances.size() == 1) {
-            for (const InstanceData& d : m_instances)
-                if (visit(d)) return;
-            return;
-        }
-        const SlabRay<T> slab(org, dir, m_top.empty() ? T(0) : abs_extent(m_top[0].volume.lo, m_top[0].volume.hi));
-        traverse_bvh(m_top, slab, tnear, q.tmax, [&](uint32_t first, uint32_t count) {
-            for (uint32_t k = 0; k < count; ++k)
-                if (visit(m_instances[m_top_ids[first + k]])) return true;
-            return false;
-        });
+        m_top.traverse(org, dir, tnear, q, visit);
     }
 
     std::string m_name;
     const Scene& m_scene;  ///< outlives the accelerator (accelerator.h): triangles of crossings
     const SurfaceFilter& m_filter;
-    bool m_bvh_top = true;
     std::vector<std::unique_ptr<Blas>> m_blas;
     std::unique_ptr<SphereBlas> m_spheres;   ///< null when the scene has no (valid) spheres
     std::vector<InstanceData> m_instances;
-    std::vector<BvhNode<AabbVolume<T>>> m_top;
-    std::vector<uint32_t> m_top_ids;
+    Top m_top;                               ///< over m_instances
     AccelStats m_stats;
 };
 
