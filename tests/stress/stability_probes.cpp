@@ -22,6 +22,7 @@
 #include "renderer/core/ray_offset.h"
 #include "renderer/integrator/camera.h"
 #include "renderer/integrator/scene_view.h"
+#include "renderer/integrator/shading_frame.h"
 #include "shading/light_sample.h"
 #include "shading/optics.h"
 
@@ -386,9 +387,9 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
             if (!cfg.smooth_normals) sp.p_shadow = sp.p;
             sp.ng = Vec3f(normalize(cross(w[1] - w[0], w[2] - w[0])));
         }
-        const Vec3f V = -cam_ray.dir;
-        const bool front = dot(sp.ng, V) >= 0.f;
-        const Vec3f Ng = front ? sp.ng : -sp.ng;
+        const ShadingFrame frame = shading_frame(sp, cam_ray.dir);  // as shade() spawns its rays
+        const bool front = frame.front;
+        const Vec3f Ng = frame.Ng;
         const double u_p = double(ulp(max_abs(sp.p)));
         const double u_offset = double(ulp(std::max(max_abs(sp.p), sp.offset_scale)));  // ray_offset.h's unit
         const Vec3d n_exact = exact_normal(Vec3d(sp.p), hit);
@@ -774,11 +775,7 @@ public:
         const RayCone secondary{cone.width_at(hit.t), cone.spread};
         const Material& mat = scene.materials[sp.material];
         const WhittedCoeffs c = m_view.coefficients(sp);
-        const Vec3f V = -ray.dir;
-        const bool front = dot(sp.ng, V) >= 0.f;
-        const Vec3f Ng = front ? sp.ng : -sp.ng;
-        Vec3f N = front ? sp.ns : -sp.ns;
-        if (dot(N, V) <= 0.f) N = Ng;
+        const auto [V, front, Ng, N] = shading_frame(sp, ray.dir);  // shade()'s orientation rule
         Color result = c.emission;
         const bool unlit = mat.model == MaterialModel::GltfPbr && mat.unlit;
         if (!unlit) {
