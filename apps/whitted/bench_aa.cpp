@@ -53,6 +53,7 @@ struct BenchAaOptions {
     std::string out = "bench-aa";    ///< output directory (CSV, images, plots)
     std::string cache;               ///< reference cache directory; empty = $XDG_CACHE_HOME/whitted or ~/.cache/whitted
     bool quick = false;              ///< a shorter sweep
+    std::vector<std::string> only;   ///< when given: run only the sweep settings whose label (as printed) is one of these
     bool replay = false;             ///< split the target runs' CPU time into ray trees and the rest (needs --threads 1)
     bool plot = true;                ///< run scripts/plot_aa.py afterwards when possible
     std::string python = "python3";  ///< interpreter with matplotlib for the plots
@@ -249,6 +250,12 @@ int run_bench_aa(const BenchAaOptions& o) {
     fs::create_directories(cache);
     if (o.timing != "cpu" && o.timing != "wall") throw Error(fmt::format("--timing: expected cpu or wall, got '{}'", o.timing));
     const bool cpu_time = o.timing == "cpu";
+    for (const std::string& label : o.only) {  // a misspelt label would silently run nothing
+        const std::vector<AaSettings> all = sweep(o.quick);
+        if (std::none_of(all.begin(), all.end(), [&](const AaSettings& aa) { return describe(aa) == label; }))
+            throw Error(fmt::format("--only '{}': no such setting in the sweep (labels as printed, e.g. 'adaptive t=0.05 "
+                                    "d=2', 'stratified 16 spp box')", label));
+    }
     if (o.replay && o.threads != 1) throw Error("bench aa: --replay compares process CPU times and needs --threads 1");
     const DisplayTransform display(ColorSettings{});
 
@@ -311,6 +318,7 @@ int run_bench_aa(const BenchAaOptions& o) {
         // load on a shared machine spreads over the settings instead of hitting one.
         std::vector<Run> runs;
         for (const AaSettings& aa : sweep(o.quick)) {
+            if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), describe(aa)) == o.only.end()) continue;
             Run r;
             r.scene = label;
             r.aa = aa;
@@ -459,6 +467,9 @@ Command register_bench_aa(CLI::App& bench) {
     app->add_option("--out", o->out, "Output directory: aa.csv, reference/adaptive/heat-map PNGs, plots")->capture_default_str();
     app->add_option("--cache", o->cache, "Reference cache directory (default $XDG_CACHE_HOME/whitted or ~/.cache/whitted)");
     app->add_flag("--quick", o->quick, "A shorter sweep");
+    app->add_option("--only", o->only, "Run only this setting of the sweep, by its printed label, e.g. "
+                    "--only 'adaptive t=0.05 d=2' --only 'stratified 16 spp box' (an A/B of two builds at the target)")
+        ->allow_extra_args(false);
     app->add_flag("--replay", o->replay, "For the target runs, time the render against replaying its camera rays "
                   "through the integrator in a plain loop (needs --threads 1)");
     app->add_flag("!--no-plot", o->plot, "Do not run scripts/plot_aa.py");

@@ -189,7 +189,13 @@ private:
 struct AdaptiveScratch {
     std::vector<Color> value;
     std::vector<uint32_t> stamp;
+    std::vector<uint32_t> split;       ///< == generation at the centre point of each square that split (squares
+                                       ///< of different sizes or places never share a centre)
     uint32_t generation = 0;
+    std::vector<int> squares, next;    ///< the squares of the current and next level: top-left grid index
+    std::array<uint32_t, WhittedIntegrator::kCameraBatch> pending;  ///< grid indices of the points to trace
+    std::array<Ray, WhittedIntegrator::kCameraBatch> pending_rays;  ///< their camera rays
+    size_t pending_count = 0;
     std::vector<Color> right;          ///< n - 1 points inside the previous pixel's right edge
     std::vector<uint8_t> right_valid;
     std::vector<Color> bottom;         ///< per tile column, n - 1 points inside the bottom edge of the pixel above
@@ -322,6 +328,7 @@ public:
         if (scratch.value.size() != points) {
             scratch.value.assign(points, Color(0.f));
             scratch.stamp.assign(points, 0u);
+            scratch.split.assign(points, 0u);
             scratch.generation = 0;
             scratch.right.assign(inner, Color(0.f));
             scratch.right_valid.assign(inner, 0);
@@ -334,10 +341,12 @@ public:
             for (int x = r.x0; x < r.x1; ++x) {
                 if (++scratch.generation == 0) {  // wrapped: invalidate every stamp once
                     std::fill(scratch.stamp.begin(), scratch.stamp.end(), 0u);
+                    std::fill(scratch.split.begin(), scratch.split.end(), 0u);
                     scratch.generation = 1;
                 }
                 PixelRecursion p{x, y, &r, 0, false};
-                const Color c = subdivide(p, scratch, rc, 0, 0, m_n, 0);
+                refine(p, scratch, rc);
+                const Color c = combine(scratch, 0, 0, m_n);
                 if (p.split) ++m_subdivided;
                 hand_over_edges(p, scratch);
                 finish_pixel(x, y, c, float(p.points), nullptr, rc);
@@ -360,41 +369,70 @@ private:
     }
     const Color& corner(int x, int y) const { return m_lattice[lattice_index(x, y)]; }
 
-    /// Sample (i, j) of pixel p's (n+1) x (n+1) grid: lattice corner, shared edge point or interior
-    /// point, each fetched or traced at most once per pixel.
-    const Color& point(PixelRecursion& p, AdaptiveScratch& s, RayCounters& rc, int i, int j) {
+    /// Requests sample (i, j) of pixel p's (n+1) x (n+1) grid, at most once per pixel: a lattice
+    /// corner or a handed-over edge point is stored at once, a point on a tile border is fetched
+    /// or traced through EdgeSamples, every other point is queued for the next flush().
+    void point(PixelRecursion& p, AdaptiveScratch& s, RayCounters& rc, int i, int j) {
         const size_t k = size_t(j) * size_t(m_n + 1) + size_t(i);
-        if (s.stamp[k] == s.generation) return s.value[k];
+        if (s.stamp[k] == s.generation) return;
         s.stamp[k] = s.generation;
         ++p.points;
         const int n = m_n;
         const bool on_x = i == 0 || i == n, on_y = j == 0 || j == n;
         if (on_x && on_y) s.value[k] = corner(p.x + i / n, p.y + j / n);
-        else if (on_x || on_y) s.value[k] = edge_point(p, s, rc, i, j);
-        else s.value[k] = sample(p.x + double(i) / n, p.y + double(j) / n, rc);
-        return s.value[k];
+        else if (on_x || on_y) {
+            if (!edge_point(p, s, rc, i, j, s.value[k])) queue(p, s, rc, i, j);
+        } else {
+            queue(p, s, rc, i, j);
+        }
+    }
+
+    /// Queues point (i, j) of pixel p for tracing in the next batch (flushed when full).
+    void queue(const PixelRecursion& p, AdaptiveScratch& s, RayCounters& rc, int i, int j) {
+        s.pending[s.pending_count] = uint32_t(j * (m_n + 1) + i);
+        s.pending_rays[s.pending_count] = m_camera.generate(p.x + double(i) / m_n, p.y + double(j) / m_n);
+        if (++s.pending_count == s.pending.size()) flush(s, rc);
+    }
+
+    /// Traces the queued points as one camera batch (WhittedIntegrator::trace_camera: Embree
+    /// packets; the same radiance as sample() gives for each) and stores them in the grid.
+    void flush(AdaptiveScratch& s, RayCounters& rc) {
+        if (s.pending_count == 0) return;
+        std::array<Color, WhittedIntegrator::kCameraBatch> c;
+        trace_row(std::span<const Ray>(s.pending_rays.data(), s.pending_count), c.data(), rc);
+        for (size_t q = 0; q < s.pending_count; ++q) s.value[s.pending[q]] = c[q];
+        s.pending_count = 0;
     }
 
     /// A point inside one of pixel p's edges (i or j is 0 or n, not both). The edge is either on the
-    /// window's border (no neighbour: traced), inside the tile (the left or upper pixel, which ran
-    /// before, handed it over when it had traced it; the right or lower one will take it from us),
-    /// or on a tile border (shared through EdgeSamples with the pixel in the other tile).
-    Color edge_point(PixelRecursion& p, AdaptiveScratch& s, RayCounters& rc, int i, int j) {
+    /// window's border (no neighbour: we trace it), inside the tile (the left or upper pixel, which
+    /// ran before, handed it over when it had traced it; the right or lower one will take it from
+    /// us), or on a tile border (shared through EdgeSamples with the pixel in the other tile). Stores
+    /// the value in `out` and returns true when it has one; false = this pixel must trace it (the
+    /// caller queues it with the pixel's batch).
+    bool edge_point(PixelRecursion& p, AdaptiveScratch& s, RayCounters& rc, int i, int j, Color& out) {
         const int n = m_n;
         const Rect& r = *p.tile;
         const PixelWindow& w = m_film.window;
-        auto trace = [&] { return sample(p.x + double(i) / n, p.y + double(j) / n, rc); };
         // Is the pixel across the edge in this tile, and in the window at all?
         bool in_tile = false, in_window = false;
         if (i == 0) {  // left edge: the previous pixel of the row handed it over
             in_tile = p.x > r.x0;
             in_window = p.x > w.x0;
-            if (in_tile) return s.right_valid[size_t(j - 1)] ? s.right[size_t(j - 1)] : trace();
+            if (in_tile) {
+                if (!s.right_valid[size_t(j - 1)]) return false;
+                out = s.right[size_t(j - 1)];
+                return true;
+            }
         } else if (j == 0) {  // top edge: the pixel above handed it over
             in_tile = p.y > r.y0;
             in_window = p.y > w.y0;
             const size_t slot = size_t(p.x - r.x0) * size_t(n - 1) + size_t(i - 1);
-            if (in_tile) return s.bottom_valid[slot] ? s.bottom[slot] : trace();
+            if (in_tile) {
+                if (!s.bottom_valid[slot]) return false;
+                out = s.bottom[slot];
+                return true;
+            }
         } else if (i == n) {  // right edge
             in_tile = p.x + 1 < r.x1;
             in_window = p.x + 1 < w.x1;
@@ -402,9 +440,11 @@ private:
             in_tile = p.y + 1 < r.y1;
             in_window = p.y + 1 < w.y1;
         }
-        if (in_tile || !in_window) return trace();  // hand_over_edges() passes it on / nobody else needs it
+        if (in_tile || !in_window) return false;  // hand_over_edges() passes it on / nobody else needs it
+        // A tile border: traced alone, inside EdgeSamples' lock, so a concurrent tile never traces it twice.
         const uint64_t gx = uint64_t(p.x) * uint64_t(n) + uint64_t(i), gy = uint64_t(p.y) * uint64_t(n) + uint64_t(j);
-        return m_edges.get(gx << 32 | gy, trace);
+        out = m_edges.get(gx << 32 | gy, [&] { return sample(p.x + double(i) / n, p.y + double(j) / n, rc); });
+        return true;
     }
 
     /// After pixel p: passes the points inside its right and bottom edges (valid when traced) to
@@ -423,21 +463,54 @@ private:
         }
     }
 
-    /// Area-weighted radiance of the sub-square with top-left grid point (i, j) and side `size`
-    /// grid steps at subdivision `level`: split into 4 while the corners differ by more than the
-    /// threshold, else the mean of its 4 corners.
-    Color subdivide(PixelRecursion& p, AdaptiveScratch& s, RayCounters& rc, int i, int j, int size, int level) {
-        const Color c00 = point(p, s, rc, i, j), c10 = point(p, s, rc, i + size, j);
-        const Color c01 = point(p, s, rc, i, j + size), c11 = point(p, s, rc, i + size, j + size);
-        if (level < m_aa.depth && aa_contrast(c00, c10, c01, c11) > m_aa.threshold) {
-            if (level == 0) p.split = true;
+    /// Whitted's recursion for pixel p, one level at a time so that the new points of a level are
+    /// traced together (camera batches) rather than one by one: a square of side `size` grid steps
+    /// at `level` splits into 4 when level < depth and its corners differ by more than the
+    /// threshold. The squares visited, the split decisions and the points traced are those of the
+    /// depth-first recursion (a point's value does not depend on when it is traced); the split
+    /// squares are marked at their centre point for combine().
+    void refine(PixelRecursion& p, AdaptiveScratch& s, RayCounters& rc) {
+        const int stride = m_n + 1;
+        auto value = [&](int i, int j) -> const Color& { return s.value[size_t(j * stride + i)]; };
+        for (int i : {0, m_n})
+            for (int j : {0, m_n}) point(p, s, rc, i, j);
+        s.squares.assign(1, 0);
+        for (int level = 0, size = m_n; level < m_aa.depth && !s.squares.empty(); ++level, size /= 2) {
             const int h = size / 2;
-            return subdivide(p, s, rc, i, j, h, level + 1) + subdivide(p, s, rc, i + h, j, h, level + 1) +
-                   subdivide(p, s, rc, i, j + h, h, level + 1) + subdivide(p, s, rc, i + h, j + h, h, level + 1);
+            s.next.clear();
+            for (const int sq : s.squares) {
+                const int i = sq % stride, j = sq / stride;
+                if (!(aa_contrast(value(i, j), value(i + size, j), value(i, j + size), value(i + size, j + size)) >
+                      m_aa.threshold))
+                    continue;
+                if (level == 0) p.split = true;
+                s.split[size_t((j + h) * stride + i + h)] = s.generation;
+                // The children's corners: the 4 edge midpoints and the centre are new.
+                point(p, s, rc, i + h, j);
+                point(p, s, rc, i, j + h);
+                point(p, s, rc, i + h, j + h);
+                point(p, s, rc, i + size, j + h);
+                point(p, s, rc, i + h, j + size);
+                for (const int child : {sq, sq + h, sq + h * stride, sq + h * stride + h}) s.next.push_back(child);
+            }
+            flush(s, rc);  // the next level's contrasts read these points
+            std::swap(s.squares, s.next);
+        }
+    }
+
+    /// Area-weighted radiance of the sub-square with top-left grid point (i, j) and side `size`
+    /// grid steps, as refine() subdivided it: the sum of its 4 children when it split, else the
+    /// mean of its 4 corners. The additions run in the depth-first order of Whitted's formula.
+    Color combine(const AdaptiveScratch& s, int i, int j, int size) const {
+        const size_t stride = size_t(m_n + 1);
+        if (size > 1 && s.split[size_t(j + size / 2) * stride + size_t(i + size / 2)] == s.generation) {
+            const int h = size / 2;
+            return combine(s, i, j, h) + combine(s, i + h, j, h) + combine(s, i, j + h, h) + combine(s, i + h, j + h, h);
         }
         // Leaf: mean of the corners times the area (a power of 2, exact) as a fraction of the pixel.
+        auto v = [&](int a, int b) -> const Color& { return s.value[size_t(b) * stride + size_t(a)]; };
         const float area = float(size) * float(size) / (float(m_n) * float(m_n));
-        return (c00 + c10 + c01 + c11) * (0.25f * area);
+        return (v(i, j) + v(i + size, j) + v(i, j + size) + v(i + size, j + size)) * (0.25f * area);
     }
 
     /// Stores a pixel and its AOVs (probing the pixel centre when the mode traced no centre ray).

@@ -1,10 +1,12 @@
 // Anti-aliasing modes: exact primary-ray counts (shared corners, adaptive recursion), the adaptive
-// estimate against an independent uniform subdivision, stratified sampling, AOVs.
+// estimate against an independent uniform subdivision and an independent depth-first recursion (pixels
+// bit for bit, ray counts), stratified sampling, AOVs.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <set>
 #include <utility>
+#include <vector>
 
 #include "renderer/core/error.h"
 #include "renderer/integrator/render.h"
@@ -195,6 +197,70 @@ TEST(AaSampling, AlwaysSplitEqualsAnIndependentUniformSubdivision) {
                         << "pixel " << x << "," << y << " depth " << depth;
             }
     }
+}
+
+TEST(AaSampling, AdaptiveEqualsAnIndependentDepthFirstRecursion) {
+    // The renderer refines a pixel one level at a time and traces each level's new points in camera
+    // batches; Whitted's recursion is depth first. With a real threshold on glass, mirrors and
+    // shadows, the test's own depth-first recursion (camera + integrator, one ray at a time) must
+    // give the same pixels bit for bit and visit as many distinct points as the renderer traces.
+    const Scene s = busy_scene();
+    const int w = 23, h = 17;
+    RenderSettings base = settings(w, h, AaMode::Adaptive);
+    base.integrator.ambient = Color(0.05f);
+    SceneView view(s, base.mapping);
+    auto accel = create_accelerator("embree", s, view, AccelConfig{base.robust, 0});
+    WhittedIntegrator integrator(view, *accel, base.integrator);
+    CameraModel camera(s.cameras[0], w, h);
+    auto radiance = [&](double x, double y) {
+        RayCounters rc;
+        return integrator.trace(camera.generate(x, y), RayKind::Camera, 0, rc, nullptr, camera.pixel_cone());
+    };
+
+    for (int depth : {1, 2, 3})
+        for (float threshold : {0.2f, 0.05f}) {
+            const int n = 1 << depth;
+            std::set<std::pair<int64_t, int64_t>> points;  // in units of 1/n pixel
+            uint64_t split_pixels = 0;
+            // Area-weighted radiance of the square at (x0, y0) (units of 1/n pixel), Whitted's formula.
+            auto visit = [&](auto&& self, int64_t x0, int64_t y0, int64_t size, int level) -> Color {
+                Color c[4];
+                int k = 0;
+                for (auto [dx, dy] : {std::pair{0, 0}, std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}}) {
+                    points.insert({x0 + dx * size, y0 + dy * size});
+                    c[k++] = radiance(double(x0 + dx * size) / n, double(y0 + dy * size) / n);
+                }
+                if (level < depth && aa_contrast(c[0], c[1], c[2], c[3]) > threshold) {
+                    if (level == 0) ++split_pixels;
+                    const int64_t half = size / 2;
+                    return self(self, x0, y0, half, level + 1) + self(self, x0 + half, y0, half, level + 1) +
+                           self(self, x0, y0 + half, half, level + 1) + self(self, x0 + half, y0 + half, half, level + 1);
+                }
+                const float area = float(size) * float(size) / (float(n) * float(n));
+                return (c[0] + c[1] + c[2] + c[3]) * (0.25f * area);
+            };
+            std::vector<Color> want(size_t(w) * size_t(h));
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) want[size_t(y * w + x)] = visit(visit, int64_t(x) * n, int64_t(y) * n, n, 0);
+            ASSERT_GT(split_pixels, 0u);
+            ASSERT_LT(split_pixels, uint64_t(w * h)) << "some pixels must stay unsplit";
+
+            for (auto [tile, threads] : {std::pair{8, 2}, std::pair{1, 3}, std::pair{5, 1}, std::pair{32, 1}}) {
+                RenderSettings rs = base;
+                rs.aa.depth = depth;
+                rs.aa.threshold = threshold;
+                rs.tile_size = tile;
+                rs.threads = threads;
+                RenderStats stats;
+                const Film film = Renderer(s, rs).render(&stats);
+                EXPECT_EQ(stats.rays.camera, points.size()) << "depth " << depth << " threshold " << threshold << " tile " << tile;
+                EXPECT_EQ(stats.pixels_subdivided, split_pixels);
+                for (int y = 0; y < h; ++y)
+                    for (int x = 0; x < w; ++x)
+                        ASSERT_EQ(film.beauty[film.index(x, y)], want[size_t(y * w + x)])
+                            << "pixel " << x << "," << y << " depth " << depth << " threshold " << threshold << " tile " << tile;
+            }
+        }
 }
 
 TEST(AaSampling, StratifiedTracesSppRaysPerPixelAndIsSeededByPixel) {
