@@ -21,6 +21,7 @@
 
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
+#include "renderer/core/uninitialized.h"
 
 #if defined(__has_feature)
 #if __has_feature(thread_sanitizer)
@@ -242,8 +243,8 @@ public:
     /// n <= kRow samples along an image row, at (x0 + i, y): generated as a row (bit for bit the
     /// rays generate() gives) and traced as one batch.
     void sample_row(int n, double x0, double y, Color* out, RayCounters& rc, PrimaryInfo* info = nullptr) {
-        std::array<Ray, kRow> rays;
-        const std::span<Ray> row(rays.data(), size_t(n));
+        UninitializedArray<Ray, kRow> rays;  // generate_row writes every ray
+        const std::span<Ray> row = rays.first(size_t(n));
         m_camera.generate_row(x0, 1.0, y, row);
         trace_row(row, out, rc, info);
     }
@@ -283,14 +284,14 @@ public:
                 Color sum(0.f);
                 for (int s0 = 0; s0 < k * k; s0 += kRow) {
                     const int n = std::min(kRow, k * k - s0);
-                    std::array<Ray, kRow> rays;
+                    UninitializedArray<Ray, kRow> rays;
                     for (int i = 0; i < n; ++i) {
                         const auto [sx, sy] = position(s0 + i);
-                        rays[size_t(i)] = m_camera.generate(sx, sy);
+                        rays.at[i] = m_camera.generate(sx, sy);
                     }
-                    std::array<Color, kRow> c;
-                    trace_row(std::span<const Ray>(rays.data(), size_t(n)), c.data(), rc);
-                    for (int i = 0; i < n; ++i) sum += c[size_t(i)];
+                    UninitializedArray<Color, kRow> c;
+                    trace_row(rays.first(size_t(n)), c.at, rc);
+                    for (int i = 0; i < n; ++i) sum += c.at[i];
                 }
                 finish_pixel(x, y, sum * float(1.0 / m_aa.spp), float(m_aa.spp), nullptr, rc);
             }

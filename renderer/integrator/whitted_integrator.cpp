@@ -12,6 +12,7 @@
 
 #include "renderer/core/error.h"
 #include "renderer/core/ray_offset.h"
+#include "renderer/core/uninitialized.h"
 #include "renderer/integrator/shading_frame.h"
 #include "shading/light_sample.h"
 #include "shading/optics.h"
@@ -363,13 +364,10 @@ void WhittedIntegrator::trace_camera_kernel(std::span<const Ray> rays, std::span
         // shaded in order exactly as trace_kernel() shades them.
         // Left uninitialised: the batch query writes every record, and filling 64 default Hits
         // per call was two thirds of this function's time on a scene of misses (the Duck).
-        union HitBuffer {
-            HitBuffer() {}
-            Hit at[kCameraBatch];
-        } hits;
+        UninitializedArray<Hit, kCameraBatch> hits;
         for (size_t begin = 0; begin < rays.size(); begin += kCameraBatch) {
             const size_t n = std::min(kCameraBatch, rays.size() - begin);
-            m_accel.intersect(rays.subspan(begin, n), RayKind::Camera, std::span<Hit>(hits.at, n));
+            m_accel.intersect(rays.subspan(begin, n), RayKind::Camera, hits.first(n));
             counters.camera += n;
             for (size_t j = 0; j < n; ++j) {
                 const size_t i = begin + j;
