@@ -40,7 +40,7 @@ namespace {
 namespace fs = std::filesystem;
 
 /// Bumped whenever a renderer change invalidates cached references.
-constexpr const char* kReferenceVersion = "aa-reference-v1";
+constexpr const char* kReferenceVersion = "aa-reference-v2";  // v2: ray offsets in units of the hit primitive
 
 struct BenchAaOptions {
     std::vector<std::string> scenes;
