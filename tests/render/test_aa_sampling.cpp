@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <set>
 #include <utility>
 #include <vector>
@@ -147,20 +148,28 @@ TEST(AaSampling, AdaptiveOnAVerticalEdgeTracesWhatTheRecursionNeeds) {
         }
 }
 
+/// The test's own radiance at image position (x, y) of a w x h image: camera + integrator, one
+/// ray at a time, no Renderer (the accelerator built as the Renderer builds it).
+struct PerRayRadiance {
+    PerRayRadiance(const Scene& s, const RenderSettings& rs, int w, int h)
+        : view(s, rs.mapping), accel(create_accelerator("embree", s, view, AccelConfig{rs.robust, 0})),
+          integrator(view, *accel, rs.integrator), camera(s.cameras[0], w, h) {}
+    Color operator()(double x, double y) const {
+        RayCounters rc;
+        return integrator.trace(camera.generate(x, y), RayKind::Camera, 0, rc, nullptr, camera.pixel_cone());
+    }
+    SceneView view;
+    std::unique_ptr<Accelerator> accel;
+    WhittedIntegrator integrator;
+    CameraModel camera;
+};
+
 TEST(AaSampling, AlwaysSplitEqualsAnIndependentUniformSubdivision) {
     const Scene s = busy_scene();
     const int w = 19, h = 13;
-    // The test's own radiance at image position (x, y): camera + integrator, no Renderer.
     RenderSettings base = settings(w, h, AaMode::Adaptive);
     base.integrator.ambient = Color(0.05f);
-    SceneView view(s, base.mapping);
-    auto accel = create_accelerator("embree", s, view, AccelConfig{base.robust, 0});  // as the Renderer builds it
-    WhittedIntegrator integrator(view, *accel, base.integrator);
-    CameraModel camera(s.cameras[0], w, h);
-    auto radiance = [&](double x, double y) {
-        RayCounters rc;
-        return integrator.trace(camera.generate(x, y), RayKind::Camera, 0, rc, nullptr, camera.pixel_cone());
-    };
+    const PerRayRadiance radiance(s, base, w, h);
 
     for (int depth : {1, 2}) {
         RenderSettings rs = base;
@@ -208,14 +217,7 @@ TEST(AaSampling, AdaptiveEqualsAnIndependentDepthFirstRecursion) {
     const int w = 23, h = 17;
     RenderSettings base = settings(w, h, AaMode::Adaptive);
     base.integrator.ambient = Color(0.05f);
-    SceneView view(s, base.mapping);
-    auto accel = create_accelerator("embree", s, view, AccelConfig{base.robust, 0});
-    WhittedIntegrator integrator(view, *accel, base.integrator);
-    CameraModel camera(s.cameras[0], w, h);
-    auto radiance = [&](double x, double y) {
-        RayCounters rc;
-        return integrator.trace(camera.generate(x, y), RayKind::Camera, 0, rc, nullptr, camera.pixel_cone());
-    };
+    const PerRayRadiance radiance(s, base, w, h);
 
     for (int depth : {1, 2, 3})
         for (float threshold : {0.2f, 0.05f}) {

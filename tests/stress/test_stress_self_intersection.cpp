@@ -124,6 +124,17 @@ TEST(StressSelfIntersection, PreviousOffsetSkipsNeighbours) {
     }
 }
 
+/// The large tilted square through the world origin at `scale`, `points` points x 6 directions.
+SelfIntersectionConfig tilted_quad(const char* accel, double scale, int points) {
+    SelfIntersectionConfig c;
+    c.accel = accel;
+    c.surface = ProbeSurface::TiltedQuad;
+    c.scale = scale;
+    c.points = points;
+    c.directions = 6;
+    return c;
+}
+
 // A large tilted square through the world origin, points down to 1e-4 of its size from the
 // origin: SceneView interpolates the hit point from float world-space vertices far larger than the
 // point, so its error is thousands of ulp(max|p|) (cancellation) and no offset relative to |p|
@@ -132,12 +143,7 @@ TEST(StressSelfIntersection, PreviousOffsetSkipsNeighbours) {
 TEST(StressSelfIntersection, TiltedQuadThroughOriginWithDoubleHitPoint) {
     for (const char* accel : {"bvh", "embree"})
         for (double s : kScales) {
-            SelfIntersectionConfig c;
-            c.accel = accel;
-            c.surface = ProbeSurface::TiltedQuad;
-            c.scale = s;
-            c.points = 300;
-            c.directions = 6;
+            SelfIntersectionConfig c = tilted_quad(accel, s, 300);
             c.exact_point = true;
             const SelfIntersectionResult r = probe_self_intersection(c);
             for (int k = 0; k < 3; ++k) EXPECT_EQ(r.self_hits[k], 0u) << label(c) << " kind " << k;
@@ -148,12 +154,7 @@ TEST(StressSelfIntersection, TiltedQuadThroughOriginWithDoubleHitPoint) {
 // the cancellation): the tilted square through the origin has no self-hits and a small error.
 TEST(StressSelfIntersection, TiltedQuadThroughOriginRendererHitPoint) {
     for (const char* accel : {"bvh", "embree"}) {
-        SelfIntersectionConfig c;
-        c.accel = accel;
-        c.surface = ProbeSurface::TiltedQuad;
-        c.scale = 1.0;
-        c.points = 300;
-        c.directions = 6;
+        const SelfIntersectionConfig c = tilted_quad(accel, 1.0, 300);
         const SelfIntersectionResult r = probe_self_intersection(c);
         EXPECT_GT(r.rays[0] + r.rays[1] + r.rays[2], 3000u) << accel;
         for (int k = 0; k < 3; ++k) EXPECT_EQ(r.self_hits[k], 0u) << accel << " kind " << k;
@@ -174,12 +175,7 @@ TEST(StressSelfIntersection, TiltedQuadThroughOriginRendererHitPoint) {
 TEST(StressSelfIntersection, LargeTriangleNearOriginEveryBackend) {
     for (const char* accel : {"brute", "grid", "octree", "kdop", "bvh", "embree"})
         for (double s : kScales) {
-            SelfIntersectionConfig c;
-            c.accel = accel;
-            c.surface = ProbeSurface::TiltedQuad;
-            c.scale = s;
-            c.points = 200;
-            c.directions = 6;
+            SelfIntersectionConfig c = tilted_quad(accel, s, 200);
             c.gap_ulps = kGuaranteedGapUlps;
             const SelfIntersectionResult r = probe_self_intersection(c);
             const std::string what = label(c);
@@ -195,11 +191,7 @@ TEST(StressSelfIntersection, LargeTriangleNearOriginEveryBackend) {
 // The probe above with the unit of the point alone (the offset before the fix): brute force
 // re-hits the square from points near the origin, so the test above can fail.
 TEST(StressSelfIntersection, PointOnlyUnitSelfHitsLargeTriangles) {
-    SelfIntersectionConfig c;
-    c.accel = "brute";
-    c.surface = ProbeSurface::TiltedQuad;
-    c.points = 200;
-    c.directions = 6;
+    SelfIntersectionConfig c = tilted_quad("brute", 1.0, 200);
     c.offset = [](const Vec3f& p, float, const Vec3f& n) { return offset_ray_origin(p, 0.f, n); };
     const SelfIntersectionResult r = probe_self_intersection(c);
     EXPECT_GT(r.self_hits[0] + r.self_hits[1] + r.self_hits[2], 0u);
