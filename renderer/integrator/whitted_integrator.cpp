@@ -430,7 +430,11 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
 
     // Orient the frame toward the viewer; `front` also says whether a ray enters the medium or
     // leaves it (shading_frame.h).
-    const auto [V, front, Ng, N] = shading_frame(sp, ray.dir);
+    // Named copies, not a structured binding: lambdas below capture them (clang 14 cannot
+    // capture structured bindings).
+    const ShadingFrame frame = shading_frame(sp, ray.dir);
+    const Vec3f V = frame.V, Ng = frame.Ng, N = frame.N;
+    const bool front = frame.front;
 
     // Touching dielectrics (DielectricContacts): the medium on the far side of this surface may
     // begin right here. `other` is that medium, entered when this one is left and left when this

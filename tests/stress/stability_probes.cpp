@@ -775,7 +775,9 @@ public:
         const RayCone secondary{cone.width_at(hit.t), cone.spread};
         const Material& mat = scene.materials[sp.material];
         const WhittedCoeffs c = m_view.coefficients(sp);
-        const auto [V, front, Ng, N] = shading_frame(sp, ray.dir);  // shade()'s orientation rule
+        const ShadingFrame frame = shading_frame(sp, ray.dir);  // shade()'s orientation rule
+        const Vec3f V = frame.V, Ng = frame.Ng, N = frame.N;
+        const bool front = frame.front;
         Color result = c.emission;
         const bool unlit = mat.model == MaterialModel::GltfPbr && mat.unlit;
         if (!unlit) {
