@@ -188,6 +188,16 @@ struct Mat4d {
     }
 };
 
+/// The box around the 8 transformed corners of `b` (exact in double for an affine map up to the
+/// corners' rounding); an empty box stays empty.
+inline Bounds3d transform_bounds(const Mat4d& m, const Bounds3d& b) {
+    Bounds3d out;
+    if (b.empty()) return out;
+    for (int c = 0; c < 8; ++c)
+        out.extend(m.apply_point({(c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z}));
+    return out;
+}
+
 constexpr float kPi = 3.14159265358979323846f;
 constexpr double kPiD = 3.14159265358979323846;
 constexpr float kInfinity = std::numeric_limits<float>::infinity();

@@ -124,13 +124,9 @@ public:
         const Vec3d d(ray.dir);
         switch (m_sub.geom_kind(hit.geom)) {
             case GeomKind::Mesh: {
-                const Mesh& mesh = m_sub.meshes[hit.geom];
-                const Mat4d& w = m_sub.instances[hit.inst].world_from_object;
-                const uint32_t* idx = &mesh.indices[size_t(hit.prim) * 3];
-                const Vec3d p0 = w.apply_point(Vec3d(mesh.positions[idx[0]]));
-                const Vec3d p1 = w.apply_point(Vec3d(mesh.positions[idx[1]]));
-                const Vec3d p2 = w.apply_point(Vec3d(mesh.positions[idx[2]]));
-                return dot(cross(p1 - p0, p2 - p0), d) < 0.0;
+                Vec3d p[3];
+                m_sub.world_triangle(hit.inst, hit.prim, p);
+                return dot(cross(p[1] - p[0], p[2] - p[0]), d) < 0.0;
             }
             case GeomKind::Sphere: {
                 const Sphere& s = m_sub.spheres[hit.geom - m_sub.meshes.size()];
@@ -233,13 +229,8 @@ std::shared_ptr<const DielectricContacts> DielectricContacts::find(const SceneVi
         const Mesh& mesh = scene.meshes[inst.mesh];
         if (!dielectric(mesh.material) || mesh.indices.empty()) continue;
         Bounds3d& mb = mesh_bounds[inst.mesh];
-        if (mb.empty())
-            for (const Vec3f& p : mesh.positions) mb.extend(Vec3d(p));
-        DielectricObject o{object_index(scene, inst.mesh, i), GeomKind::Mesh, {}};
-        for (int c = 0; c < 8; ++c)
-            o.bounds.extend(inst.world_from_object.apply_point(
-                {(c & 1) ? mb.hi.x : mb.lo.x, (c & 2) ? mb.hi.y : mb.lo.y, (c & 4) ? mb.hi.z : mb.lo.z}));
-        objects.push_back(o);
+        if (mb.empty()) mb = mesh.bounds();
+        objects.push_back({object_index(scene, inst.mesh, i), GeomKind::Mesh, transform_bounds(inst.world_from_object, mb)});
     }
     for (size_t i = 0; i < scene.spheres.size(); ++i) {
         const Sphere& s = scene.spheres[i];

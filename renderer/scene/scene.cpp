@@ -11,16 +11,11 @@ void Scene::warn(const std::string& message) {
 Bounds3d Scene::world_bounds() const {
     // Object-space bounds per mesh once, then the 8 transformed corners per instance.
     std::vector<Bounds3d> mesh_bounds(meshes.size());
-    for (size_t i = 0; i < meshes.size(); ++i)
-        for (const Vec3f& p : meshes[i].positions) mesh_bounds[i].extend(Vec3d(p));
+    for (size_t i = 0; i < meshes.size(); ++i) mesh_bounds[i] = meshes[i].bounds();
     Bounds3d b;
     for (const Instance& inst : instances) {
         const Bounds3d& mb = mesh_bounds[inst.mesh];
-        if (mb.empty()) continue;
-        for (int c = 0; c < 8; ++c) {
-            Vec3d corner{(c & 1) ? mb.hi.x : mb.lo.x, (c & 2) ? mb.hi.y : mb.lo.y, (c & 4) ? mb.hi.z : mb.lo.z};
-            b.extend(inst.world_from_object.apply_point(corner));
-        }
+        if (!mb.empty()) b.extend(transform_bounds(inst.world_from_object, mb));
     }
     for (const Sphere& s : spheres) {
         b.extend(s.center - Vec3d(s.radius));

@@ -31,6 +31,12 @@ struct Mesh {
     uint32_t material = 0;            ///< index into Scene::materials
 
     size_t triangle_count() const { return indices.size() / 3; }
+    /// Object-space bounds of the positions (computed, not cached).
+    Bounds3d bounds() const {
+        Bounds3d b;
+        for (const Vec3f& p : positions) b.extend(Vec3d(p));
+        return b;
+    }
 };
 
 /// A mesh placed in the world.
@@ -302,6 +308,14 @@ struct Scene {
 
     /// Adds a warning unless the same text was already recorded.
     void warn(const std::string& message);
+    /// World-space vertices of triangle `prim` of instance `inst`, transformed in double from the
+    /// mesh's float positions.
+    void world_triangle(uint32_t inst, uint32_t prim, Vec3d out[3]) const {
+        const Instance& in = instances[inst];
+        const Mesh& m = meshes[in.mesh];
+        for (int k = 0; k < 3; ++k)
+            out[k] = in.world_from_object.apply_point(Vec3d(m.positions[m.indices[size_t(prim) * 3 + size_t(k)]]));
+    }
     /// World-space bounds of all instances and spheres (computed, not cached; planes are infinite
     /// and not included).
     Bounds3d world_bounds() const;

@@ -168,19 +168,12 @@ SceneAnalysis analyze_scene(const Scene& scene, const MappingOptions& mapping) {
 
     // Light reach per object: instances (transformed mesh bounds), spheres, planes.
     std::vector<Bounds3d> mesh_bounds(scene.meshes.size());
-    for (size_t i = 0; i < scene.meshes.size(); ++i)
-        for (const Vec3f& p : scene.meshes[i].positions) mesh_bounds[i].extend(Vec3d(p));
+    for (size_t i = 0; i < scene.meshes.size(); ++i) mesh_bounds[i] = scene.meshes[i].bounds();
     std::vector<Bounds3d> object_bounds;
     object_bounds.reserve(scene.instances.size() + scene.spheres.size());
-    for (const Instance& inst : scene.instances) {
-        Bounds3d b;
-        const Bounds3d mb = inst.mesh < mesh_bounds.size() ? mesh_bounds[inst.mesh] : Bounds3d{};
-        if (!mb.empty())
-            for (int c = 0; c < 8; ++c)
-                b.extend(inst.world_from_object.apply_point(
-                    {(c & 1) ? mb.hi.x : mb.lo.x, (c & 2) ? mb.hi.y : mb.lo.y, (c & 4) ? mb.hi.z : mb.lo.z}));
-        object_bounds.push_back(b);
-    }
+    for (const Instance& inst : scene.instances)
+        object_bounds.push_back(transform_bounds(
+            inst.world_from_object, inst.mesh < mesh_bounds.size() ? mesh_bounds[inst.mesh] : Bounds3d{}));
     for (const Sphere& sp : scene.spheres) {
         Bounds3d b;
         b.extend(sp.center - Vec3d(sp.radius));

@@ -111,7 +111,7 @@ public:
         if (!m_mixed.accept(r, h, k)) return false;
         if (k != RayKind::Camera || !culled(h.geom)) return true;
         Vec3d p[3];
-        world_triangle(m_scene, h.inst, h.prim, p);
+        m_scene.world_triangle(h.inst, h.prim, p);
         return dot(cross(p[1] - p[0], p[2] - p[0]), Vec3d(r.dir)) <= 0.0;
     }
     Color transmittance(const Ray& r, const Hit& h) const override { return m_mixed.transmittance(r, h); }

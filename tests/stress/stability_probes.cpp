@@ -89,13 +89,6 @@ void add_instance(Scene& s, uint32_t mesh, const Mat4d& xf) {
     s.instances.push_back(inst);
 }
 
-/// World-space triangle of `prim` of instance `inst`, in double (vertices are the mesh's floats).
-void world_triangle(const Scene& s, uint32_t inst, uint32_t prim, Vec3d out[3]) {
-    const Instance& in = s.instances[inst];
-    const Mesh& m = s.meshes[in.mesh];
-    for (int k = 0; k < 3; ++k) out[k] = in.world_from_object.apply_point(Vec3d(m.positions[m.indices[size_t(prim) * 3 + size_t(k)]]));
-}
-
 /// Filter of the self-intersection probe: geometry "A" is opaque, the neighbours transmit 0.5;
 /// camera rays accept only A (they pass through the outer neighbour to reach it).
 class ProbeFilter final : public SurfaceFilter {
@@ -316,14 +309,14 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
     auto surface_distance = [&](const Vec3d& x, const Hit& hit) {
         if (analytic) return length(x - centre) - s;
         Vec3d w[3];
-        world_triangle(scene, 0, hit.prim, w);
+        scene.world_triangle(0, hit.prim, w);
         return dot(x - w[0], normalize(cross(w[1] - w[0], w[2] - w[0])));
     };
     // Exact outward normal of A at the hit.
     auto exact_normal = [&](const Vec3d& x, const Hit& hit) {
         if (analytic) return normalize(x - centre);
         Vec3d w[3];
-        world_triangle(scene, 0, hit.prim, w);
+        scene.world_triangle(0, hit.prim, w);
         return normalize(cross(w[1] - w[0], w[2] - w[0]));
     };
     // Which side of the neighbour `hit` a ray with direction `dir` crossed: +1 leaving, -1 entering.
@@ -334,7 +327,7 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
             n = p - centre;
         } else {
             Vec3d w[3];
-            world_triangle(scene, h.inst, h.prim, w);
+            scene.world_triangle(h.inst, h.prim, w);
             n = cross(w[1] - w[0], w[2] - w[0]);
         }
         return dot(n, Vec3d(r.dir)) > 0.0 ? 1 : -1;
@@ -358,7 +351,7 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
         } else {
             const uint32_t prim = uint32_t(u01(rng) * double(mesh->triangle_count())) % uint32_t(mesh->triangle_count());
             Vec3d w[3];
-            world_triangle(scene, 0, prim, w);
+            scene.world_triangle(0, prim, w);
             double a = u01(rng), b = u01(rng);
             if (a + b > 1.0) a = 1.0 - a, b = 1.0 - b;
             target = w[0] * (1.0 - a - b) + w[1] * a + w[2] * b;
@@ -381,7 +374,7 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
         if (cfg.exact_point && !analytic) {
             // The proposed SceneView: world vertices and the barycentric blend in double, one rounding.
             Vec3d w[3];
-            world_triangle(scene, 0, hit.prim, w);
+            scene.world_triangle(0, hit.prim, w);
             const double u = hit.u, v = hit.v;
             sp.p = Vec3f(w[0] * (1.0 - u - v) + w[1] * u + w[2] * v);
             if (!cfg.smooth_normals) sp.p_shadow = sp.p;
@@ -458,7 +451,7 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
                     bool exact_crossing = false;
                     if (!analytic && h.prim != hit.prim) {
                         Vec3d w[3];
-                        world_triangle(scene, 0, h.prim, w);
+                        scene.world_triangle(0, h.prim, w);
                         const Vec3d nh = cross(w[1] - w[0], w[2] - w[0]);
                         exact_crossing = dot(Vec3d(r.org) - w[0], nh) * dot(dir_d, nh) < 0.0;
                     }
@@ -663,7 +656,7 @@ HitErrorResult probe_hit_error(const std::string& accel_name, bool sphere, doubl
             exact = o + d * (t0 > 0.0 ? t0 : t1);
         } else {
             Vec3d w[3];
-            world_triangle(scene, 0, hd.prim, w);
+            scene.world_triangle(0, hd.prim, w);
             const Vec3d n = cross(w[1] - w[0], w[2] - w[0]);
             exact = o + d * (dot(w[0] - o, n) / dot(d, n));
         }

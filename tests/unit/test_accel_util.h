@@ -164,13 +164,6 @@ inline uint32_t add_mesh_instance(Scene& s, Mesh m, const Mat4d& xf = Mat4d::ide
     return uint32_t(s.meshes.size() - 1);
 }
 
-/// World-space vertices of triangle `prim` of instance `inst`.
-inline void world_triangle(const Scene& s, uint32_t inst, uint32_t prim, Vec3d p[3]) {
-    const Instance& in = s.instances[inst];
-    const Mesh& m = s.meshes[in.mesh];
-    for (int k = 0; k < 3; ++k) p[k] = in.world_from_object.apply_point(Vec3d(m.positions[m.indices[3 * prim + uint32_t(k)]]));
-}
-
 /// Random rays from around the scene box towards points inside it, plus the edge cases: through
 /// vertices, through edge midpoints, parallel to the axes (with +0 and -0 components), origins on
 /// surfaces (tnear = 0). Rays with `tfar` set exactly to a hit are added by the tests.
@@ -200,7 +193,7 @@ inline std::vector<Ray> make_rays(const Scene& s, uint32_t count, uint32_t seed)
         if (m.triangle_count() == 0) continue;
         const uint32_t prim = uint32_t(rng() % m.triangle_count());
         Vec3d p[3];
-        world_triangle(s, inst, prim, p);
+        s.world_triangle(inst, prim, p);
         add(outside(), p[i % 3]);
         add(outside(), (p[i % 3] + p[(i + 1) % 3]) * 0.5);
         // Origin on the surface, leaving it.

@@ -218,22 +218,14 @@ private:
     /// instance transform, in double); 1 for spheres, whose two roots are told apart by `part`.
     float world_cosine(const Crossing& c, const Ray& ray) const {
         if (c.inst == kInvalidId) return 1.f;
-        const Instance& inst = m_scene.instances[c.inst];
-        const Mesh& mesh = m_scene.meshes[inst.mesh];
         Vec3d p[3];
-        for (int k = 0; k < 3; ++k)
-            p[k] = inst.world_from_object.apply_point(Vec3d(mesh.positions[mesh.indices[3 * size_t(c.prim) + size_t(k)]]));
+        m_scene.world_triangle(c.inst, c.prim, p);
         return crossing_cosine(cross(p[1] - p[0], p[2] - p[0]), Vec3d(ray.dir));
     }
 
     /// World box of an object box under a transform (corners in double, rounded outwards).
     static Bounds3<T> world_box(const Bounds3<T>& object, const Mat4d& world_from_object) {
-        Bounds3d b;
-        for (int c = 0; c < 8; ++c) {
-            const Vec3d p{double((c & 1) ? object.hi.x : object.lo.x), double((c & 2) ? object.hi.y : object.lo.y),
-                          double((c & 4) ? object.hi.z : object.lo.z)};
-            b.extend(world_from_object.apply_point(p));
-        }
+        const Bounds3d b = transform_bounds(world_from_object, Bounds3d{Vec3d(object.lo), Vec3d(object.hi)});
         Bounds3<T> out;
         for (int k = 0; k < 3; ++k) {
             T lo = T(b.lo[k]), hi = T(b.hi[k]);
