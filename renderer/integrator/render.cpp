@@ -307,9 +307,9 @@ public:
         for (int y = r.y0; y < cy1; ++y)
             for (int x0 = r.x0; x0 < cx1; x0 += kRow) {
                 const int n = std::min(kRow, cx1 - x0);
-                std::array<Color, kRow> c;
-                sample_row(n, double(x0), double(y), c.data(), rc);
-                for (int i = 0; i < n; ++i) m_lattice[lattice_index(x0 + i, y)] = c[size_t(i)];
+                UninitializedArray<Color, kRow> c;
+                sample_row(n, double(x0), double(y), c.at, rc);
+                for (int i = 0; i < n; ++i) m_lattice[lattice_index(x0 + i, y)] = c.at[i];
             }
     }
 
@@ -399,9 +399,9 @@ private:
     /// packets; the same radiance as sample() gives for each) and stores them in the grid.
     void flush(AdaptiveScratch& s, RayCounters& rc) {
         if (s.pending_count == 0) return;
-        std::array<Color, WhittedIntegrator::kCameraBatch> c;
-        trace_row(std::span<const Ray>(s.pending_rays.data(), s.pending_count), c.data(), rc);
-        for (size_t q = 0; q < s.pending_count; ++q) s.value[s.pending[q]] = c[q];
+        UninitializedArray<Color, WhittedIntegrator::kCameraBatch> c;
+        trace_row(std::span<const Ray>(s.pending_rays.data(), s.pending_count), c.at, rc);
+        for (size_t q = 0; q < s.pending_count; ++q) s.value[s.pending[q]] = c.at[q];
         s.pending_count = 0;
     }
 
