@@ -39,6 +39,10 @@ struct BenchStabilityOptions {
     int threads = 0;                        ///< 0 = all cores
     std::string sections = "all";           ///< comma list: self,images,watertight,energy,refraction,deep,hiterror
     std::vector<float> offset_ulps;         ///< self: sweep these offsets instead of the standard variants
+    bool skip_origin = false;               ///< self: queries skip the origin's own primitive (experiment)
+    bool double_origin = false;             ///< self: --offset-ulps from the double hit point, directed rounding
+    float scale_factor = 1.f;               ///< self: --offset-ulps in ulps of max(max|p|, factor * offset_scale)
+    std::vector<std::string> accels;        ///< self: only these backends (empty = all)
 };
 
 /// One CSV row per measurement: section, case columns, metric, value.
@@ -102,17 +106,19 @@ void run_self_intersection(const BenchStabilityOptions& o, Csv& csv) {
             for (const ProbeSurface s : {ProbeSurface::MeshSphere, ProbeSurface::AnalyticSphere, ProbeSurface::TiltedQuad})
                 variants.push_back({s, false, false, false, u});
     }
-    auto offset_name = [](const Variant& v) {
-        return v.previous     ? std::string("previous (W&B 2019)")
-               : v.point_unit ? std::string("ulps of max\\|p\\| alone")
-               : v.offset_ulps > 0.f ? fmt::format("{:g} ulp", v.offset_ulps)
-                                     : std::string("current");
+    auto offset_name = [&o](const Variant& v) {
+        const std::string experiment = std::string(o.double_origin ? ", double origin" : "") + (o.skip_origin ? ", origin primitive skipped" : "");
+        return (v.previous     ? std::string("previous (W&B 2019)")
+                : v.point_unit ? std::string("ulps of max\\|p\\| alone")
+                : !o.offset_ulps.empty() ? fmt::format("{:g} ulp", v.offset_ulps)
+                                         : std::string("current")) + experiment;
     };
     // The backends without a per-primitive box test (brute, grid, octree) are the ones that found
     // large triangles again near the origin; they run the (two-triangle) tilted quad only.
-    for (const char* accel : {"bvh", "embree", "kdop", "grid", "octree", "brute"})
+    for (const char* accel : {"bvh", "bvh:precision=double", "embree", "kdop", "grid", "octree", "brute", "brute:precision=double"})
         for (const Variant& v : variants) {
-            const bool fast = std::string(accel) == "bvh" || std::string(accel) == "embree";
+            if (!o.accels.empty() && std::find(o.accels.begin(), o.accels.end(), accel) == o.accels.end()) continue;
+            const bool fast = std::string(accel).starts_with("bvh") || std::string(accel) == "embree";
             if (!fast && v.surface != ProbeSurface::TiltedQuad) continue;
             uint64_t rays = 0, self = 0, miss4 = 0, miss12 = 0;
             double off_min = 1e300, off_max = 0, perr = 0, nerr = 0;
@@ -133,9 +139,11 @@ void run_self_intersection(const BenchStabilityOptions& o, Csv& csv) {
                         c.gap_ulps = gap;
                         if (v.previous) c.offset = wachter_binder_2019;
                         if (v.offset_ulps > 0.f)
-                            c.offset = [u = v.offset_ulps](const Vec3f& p, float scale, const Vec3f& n) {
-                                return offset_ray_origin(p, scale, n, u);
+                            c.offset = [u = v.offset_ulps, f = o.scale_factor](const Vec3f& p, float scale, const Vec3f& n) {
+                                return offset_ray_origin(p, f * scale, n, u);
                             };
+                        c.skip_origin = o.skip_origin;
+                        if (o.double_origin && !o.offset_ulps.empty()) c.double_origin_ulps = v.offset_ulps;
                         if (v.point_unit)
                             c.offset = [](const Vec3f& p, float, const Vec3f& n) { return offset_ray_origin(p, 0.f, n); };
                         SelfIntersectionResult r = probe_self_intersection(c);
@@ -401,7 +409,17 @@ Command register_bench_stability(CLI::App& bench) {
                     "Self-intersection: sweep these ray-offset distances (ulps of max(max|p|, the hit primitive's coordinates)) with the renderer's hit points "
                     "instead of the standard variants")
         ->delimiter(',')
-        ->check(CLI::Range(0.01f, 4096.f));
+        ->check(CLI::Range(0.f, 4096.f));
+    app->add_option("--scale-factor", o->scale_factor,
+                    "Self-intersection: --offset-ulps in ulps of max(max|p|, factor x the hit primitive's coordinates)")
+        ->check(CLI::Range(0.f, 1.f));
+    app->add_option("--accels", o->accels, "Self-intersection: only these backends (comma list, e.g. bvh:precision=double)")
+        ->delimiter(',');
+    app->add_flag("--skip-origin", o->skip_origin,
+                  "Self-intersection experiment: queries that hit the origin's own primitive are repeated beyond it");
+    app->add_flag("--double-origin", o->double_origin,
+                  "Self-intersection experiment: --offset-ulps origins formed in double from the double hit point and "
+                  "rounded away from the surface");
     app->add_option("--sections", o->sections, "Comma list of self,images,watertight,energy,refraction,deep,hiterror or all")
         ->capture_default_str();
     return Command{app, [o] { return run_bench_stability(*o); }};

@@ -68,6 +68,7 @@ public:
         return m_inner.transmittance(ray);
     }
     std::string name() const override { return m_inner.name(); }
+    RayOffsetPolicy ray_offset() const override { return m_inner.ray_offset(); }
     AccelStats stats() const override { return m_inner.stats(); }
 
     /// All rays, thread by thread (each thread's log keeps its tiles' coherent order).

@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "renderer/core/ray_offset.h"
 #include "renderer/core/vecmath.h"
 
 namespace whitted {
@@ -98,9 +99,43 @@ struct AccelStats {
     double sah_cost = 0.0;                    ///< SAH cost of BVH-like trees, triangle-weighted (0 = n/a)
 };
 
+/// How far a backend needs secondary-ray origins moved off their surface, and what it then
+/// guarantees (renderer/core/ray_offset.h; docs/numerical-stability.md, section 1). The unit is
+/// ulp(max(max|p|, scale_factor * SurfacePoint::offset_scale)).
+struct RayOffsetPolicy {
+    float ulps;          ///< the origin moves this many units along the normal (then one float step)
+    float scale_factor;  ///< how much of the hit primitive's coordinate magnitude the unit follows
+    float gap_ulps;      ///< every surface at least this many units in front of an origin is hit
+
+    Vec3f origin(const Vec3f& p, float offset_scale, const Vec3f& n) const {
+        return offset_ray_origin(p, scale_factor * offset_scale, n, ulps);
+    }
+    /// gap_ulps units as a distance: nearer surfaces may be skipped (touching dielectrics are
+    /// looked for explicitly within it, renderer/integrator/whitted_integrator.cpp).
+    float gap(const Vec3f& p, float offset_scale) const {
+        return gap_ulps * detail::offset_unit(p, scale_factor * offset_scale);
+    }
+};
+
+/// Float traversal (Embree and the in-house float backends): its rounding is a few ulps of the
+/// primitive's coordinates, so origins move 4 ulps of max(max|p|, the primitive's coordinates)
+/// and every surface 12 of them away is hit. Measured: no offset gives both "no self-hit" and
+/// "every neighbour 4 ulps away hit" with float traversal (numerical-stability.md, section 1).
+inline constexpr RayOffsetPolicy kFloatRayOffset{detail::kOffsetUlps, 1.f, kGuaranteedGapUlps};
+
+/// Double traversal (bvh:precision=double, brute:precision=double): its rounding is ~2^-29 of a
+/// float ulp, so the origin need only be strictly off the surface. Half an ulp of
+/// max(max|p|, 2^-26 * the primitive's coordinates) (the 2^-26 floor keeps the unit above the
+/// double hit point's error near the world origin) plus the float rounding puts origins 0.5 to
+/// 2.5 units away, and every surface 4 ulps away is hit: the issue's 4 * ulp(max|p|) (issue #7).
+inline constexpr RayOffsetPolicy kDoubleRayOffset{0.5f, 0x1p-26f, 4.f};
+
 class Accelerator {
 public:
     virtual ~Accelerator() = default;
+    /// The ray-offset policy this backend's rounding needs (kFloatRayOffset unless it traverses
+    /// in double). The integrator moves every secondary-ray origin by it.
+    virtual RayOffsetPolicy ray_offset() const { return kFloatRayOffset; }
     /// Closest accepted hit along [tnear, tfar], or an invalid Hit.
     virtual Hit intersect(const Ray& ray, RayKind kind) const = 0;
     /// Closest hits of a batch of rays of one kind (hits.size() == rays.size(), else throws):

@@ -29,6 +29,9 @@
 // (`whitted bench stability --offset-ulps`, docs/numerical-stability.md section 1): 3 ulps still
 // self-hits on objects that collapse to a few float steps, 1-2 ulps also on resolvable ones, and
 // no offset reaches neighbours 4 ulps away (origins end over a ~3-ulp spread of distances).
+// That is float traversal's limit: each accelerator states the offset its rounding needs
+// (Accelerator::ray_offset(), RayOffsetPolicy in renderer/accel/accelerator.h), and the
+// double-precision backends need only half an ulp, which reaches 4-ulp neighbours.
 #pragma once
 
 #include <bit>

@@ -103,7 +103,9 @@ public:
 
     /// The front face of another non-thin dielectric within guaranteed_gap(p, scale) of p (scale:
     /// the surface hit's SurfacePoint::offset_scale, the unit secondary rays leave it by), found by
-    /// a probe from just inside the surface hit along its outward unit normal.
+    /// a probe from just inside the surface hit along its outward unit normal. The reach is the
+    /// float path's 12 units whatever the main accelerator: at least any RayOffsetPolicy's gap,
+    /// so no surface a secondary ray may skip goes unlooked for.
     std::optional<Contact> at(const Vec3f& p, float scale, const Vec3f& outward) const {
         const float reach = guaranteed_gap(p, scale);
         Contact c;
@@ -306,7 +308,7 @@ std::shared_ptr<const DielectricContacts> DielectricContacts::find(const SceneVi
 }
 
 WhittedIntegrator::WhittedIntegrator(const SceneView& view, const Accelerator& accel, const IntegratorSettings& settings)
-    : m_view(view), m_accel(accel), m_settings(settings),
+    : m_view(view), m_accel(accel), m_offset(accel.ray_offset()), m_settings(settings),
       m_kernel(select_kernel(view.analysis().features, settings)) {
     // The instantiation for the selected features, chosen once (no per-ray dispatch below).
     auto pick = [&]<size_t... I>(std::index_sequence<I...>) {
@@ -451,7 +453,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
     if (!unlit) {
         // Local model: I = Ia Ka + sum_i Is_i fat_i s_i (kd (N.L) + ks (N.H)^n).
         result += m_settings.ambient * c.ka;
-        const Vec3f shadow_org = offset_ray_origin(front ? sp.p_shadow : sp.p, sp.offset_scale, Ng);
+        const Vec3f shadow_org = m_offset.origin(front ? sp.p_shadow : sp.p, sp.offset_scale, Ng);
         const bool diffuse_or_specular = !is_black(c.kd) || !is_black(c.ks);
         auto add_light = [&](const Light& light) {
             LightSample ls = sample_light(light, sp.p);
@@ -516,7 +518,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                     if (!is_black(kt) && wt < m_settings.min_weight) ++counters.secondary_skipped_cutoff;
                     if (!is_black(kt) && wt >= m_settings.min_weight) {
                         Ray t;
-                        t.org = offset_ray_origin(sp.p, sp.offset_scale, -Ng);
+                        t.org = m_offset.origin(sp.p, sp.offset_scale, -Ng);
                         bool transmitted = true;
                         if (c.thin) {
                             t.dir = ray.dir;  // thin-walled: straight through
@@ -527,7 +529,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                                 // (no total internal reflection in a gap of zero width), and the ray
                                 // starts past both surfaces.
                                 eta *= front ? other->c.ior : 1.f / other->c.ior;
-                                const Vec3f past_other = offset_ray_origin(other->p, std::max(sp.offset_scale, other->offset_scale), -Ng);
+                                const Vec3f past_other = m_offset.origin(other->p, std::max(sp.offset_scale, other->offset_scale), -Ng);
                                 if (dot(past_other - t.org, Ng) < 0.f) t.org = past_other;
                             }
                             auto dir = refract(ray.dir, N, eta);
@@ -548,7 +550,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                     Vec3f R = reflect(V, N);
                     if (dot(R, Ng) <= 0.f) R = reflect(V, Ng);
                     Ray r;
-                    r.org = offset_ray_origin(sp.p, sp.offset_scale, Ng);
+                    r.org = m_offset.origin(sp.p, sp.offset_scale, Ng);
                     r.dir = normalize(R);
                     result += kr * trace_kernel<K>(r, RayKind::Reflection, depth + 1, counters, nullptr, secondary, wr);
                 }
@@ -570,7 +572,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
             else alpha = std::clamp(m_view.material_inputs(mat, sp).base_color.w, 0.f, 1.f);
             if (alpha < 1.f) {
                 Ray behind;
-                behind.org = offset_ray_origin(sp.p, sp.offset_scale, -Ng);
+                behind.org = m_offset.origin(sp.p, sp.offset_scale, -Ng);
                 behind.dir = ray.dir;
                 // Below min_weight the branch behind is dropped (contributes 0) like the others.
                 const float wb = weight * (1.f - alpha);

@@ -161,6 +161,7 @@ private:
 
     const SceneView& m_view;
     const Accelerator& m_accel;
+    RayOffsetPolicy m_offset;  ///< m_accel's: how far secondary-ray origins leave their surface
     IntegratorSettings m_settings;
     KernelFeatures m_kernel;
     TraceFn m_trace = nullptr;

@@ -332,6 +332,28 @@ TEST(AccelEmbreeStats, BytesAreTheMemoryMonitorsCount) {
     EXPECT_THROW((void)create_accelerator("embree:compact=2", s, filter), Error);
 }
 
+// Each backend states the ray offset its rounding needs (RayOffsetPolicy): double traversal the
+// half-ulp one with the 4-ulp guarantee, everything float the 4-ulp offset with 12; the planes'
+// decorator (contract_scene has a plane) passes its backend's policy on.
+TEST(AccelRayOffset, PolicyFollowsTheTraversalPrecision) {
+    const Scene s = contract_scene();
+    const CullingFilter filter(s);
+    for (const char* name : {"embree", "bvh", "bvh:width=8", "kdop", "grid", "octree", "brute", "bvh:precision=double",
+                             "bvh:precision=double,bv=sphere", "brute:precision=double"}) {
+        SCOPED_TRACE(name);
+        const auto accel = create_accelerator(name, s, filter);
+        const RayOffsetPolicy p = accel->ray_offset();
+        const bool precise = std::string(name).find("precision=double") != std::string::npos;
+        EXPECT_EQ(p.gap_ulps, precise ? 4.f : kGuaranteedGapUlps);
+        EXPECT_EQ(p.ulps, precise ? 0.5f : 4.f);
+        EXPECT_EQ(p.scale_factor, precise ? 0x1p-26f : 1.f);
+        // What the integrator does with it: a point 1e-3 from the origin on a triangle of size 8.
+        const Vec3f o = p.origin(Vec3f(1e-3f, 0.f, 0.f), 8.f, Vec3f(0, 0, 1));
+        EXPECT_GE(o.z, p.ulps * (precise ? 0x1p-33f : 0x1p-20f));  // ulp(1e-3) = 2^-33, ulp(8) = 2^-20
+        EXPECT_EQ(p.gap(Vec3f(1e-3f, 0.f, 0.f), 8.f), p.gap_ulps * (precise ? 0x1p-33f : 0x1p-20f));
+    }
+}
+
 TEST(AccelBatch, EmptyBatchAndSizeMismatch) {
     const Scene s = batch_analytic_scene();
     const CullingFilter filter(s);

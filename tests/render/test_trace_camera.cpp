@@ -33,6 +33,7 @@ public:
     }
     Color transmittance(const Ray& ray) const override { return m_inner.transmittance(ray); }
     std::string name() const override { return m_inner.name(); }
+    RayOffsetPolicy ray_offset() const override { return m_inner.ray_offset(); }
     AccelStats stats() const override { return m_inner.stats(); }
     mutable size_t batches = 0;  // single-threaded test
 

@@ -301,8 +301,8 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
     ProbeFilter filter(scene);
     const SceneView view(scene, MappingOptions{});
     const auto accel = create_accelerator(cfg.accel, scene, filter, AccelConfig{cfg.robust, 0});
-    const OffsetFn offset = cfg.offset ? cfg.offset : OffsetFn([](const Vec3f& p, float scale, const Vec3f& n) {
-        return offset_ray_origin(p, scale, n);
+    const OffsetFn offset = cfg.offset ? cfg.offset : OffsetFn([policy = accel->ray_offset()](const Vec3f& p, float scale, const Vec3f& n) {
+        return policy.origin(p, scale, n);
     });
 
     // Signed distance of x from the exact surface of A (positive outside), in double.
@@ -389,10 +389,29 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
         res.point_error_ulps.push_back(std::fabs(surface_distance(Vec3d(sp.p), hit)) / u_p);
         res.normal_error_rad.push_back(angle_between(Vec3d(sp.ng), n_exact));
 
+        // The hit point in double, before SceneView rounds it (the double-origin experiment).
+        Vec3d p_double = Vec3d(sp.p);
+        if (cfg.double_origin_ulps >= 0.0) {
+            if (analytic) {
+                p_double = centre + normalize(Vec3d(cam_ray.org) + Vec3d(cam_ray.dir) * double(hit.t) - centre) * s;
+            } else {
+                Vec3d w[3];
+                scene.world_triangle(0, hit.prim, w);
+                p_double = w[0] * (1.0 - double(hit.u) - double(hit.v)) + w[1] * double(hit.u) + w[2] * double(hit.v);
+            }
+        }
         for (int kind = 0; kind < 3; ++kind) {
             const bool inward = kind == 1;
             const Vec3f base = kind == 2 && front ? sp.p_shadow : sp.p;
-            const Vec3f org = offset(base, sp.offset_scale, inward ? -Ng : Ng);
+            Vec3f org = offset(base, sp.offset_scale, inward ? -Ng : Ng);
+            if (cfg.double_origin_ulps >= 0.0 && !(kind == 2 && cfg.smooth_normals)) {
+                const Vec3d nd = Vec3d(inward ? -Ng : Ng);
+                const Vec3d od = p_double + nd * (cfg.double_origin_ulps * u_offset);
+                for (int k = 0; k < 3; ++k) {
+                    org[k] = float(od[k]);
+                    if ((double(org[k]) - od[k]) * nd[k] < 0.0) org[k] = std::nextafter(org[k], nd[k] > 0.0 ? kInfinity : -kInfinity);
+                }
+            }
             const double dist = surface_distance(Vec3d(org), hit) / u_offset * (inward ? -1.0 : 1.0);
             if (kind < 2 || !cfg.smooth_normals) {  // lifted shadow origins are not offsets
                 res.max_offset_ulps = std::max(res.max_offset_ulps, std::fabs(dist));
@@ -410,6 +429,27 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
                     continue;
                 }
                 ++res.rays[kind];
+                // The skip-origin experiment: repeat a query that found the origin's own
+                // primitive from just beyond it (for the analytic sphere, only its root at the
+                // origin: an inward ray's far side is a true hit).
+                auto query = [&](Ray q, RayKind rk) {
+                    Hit h = accel->intersect(q, rk);
+                    for (int retry = 0; cfg.skip_origin && retry < 4 && h.valid() && filter.is_a(h) && h.prim == hit.prim &&
+                                        (!analytic || double(h.t) < s * std::fabs(dot(dir_d, n_exact)));
+                         ++retry) {
+                        q.tnear = std::nextafter(h.t, kInfinity);
+                        h = accel->intersect(q, rk);
+                    }
+                    return h;
+                };
+                if (kind == 2 && cfg.skip_origin) {
+                    const bool checked = std::fabs(dot(dir_d, n_exact)) >= cfg.neighbour_min_cos;
+                    if (!checked) ++res.neighbour_unchecked;
+                    const Hit h = query(r, RayKind::Reflection);
+                    if (h.valid() && filter.is_a(h)) ++res.self_hits[kind];
+                    else if (checked && (!h.valid() || crossing_side(r, h) != 1)) ++res.neighbour_misses[kind];
+                    continue;
+                }
                 if (kind == 2) {
                     const bool checked = std::fabs(dot(dir_d, n_exact)) >= cfg.neighbour_min_cos;
                     if (!checked) ++res.neighbour_unchecked;
@@ -441,7 +481,7 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
                         neighbour_checked = false;
                     }
                 }
-                const Hit h = accel->intersect(r, inward ? RayKind::Refraction : RayKind::Reflection);
+                const Hit h = query(r, inward ? RayKind::Refraction : RayKind::Reflection);
                 if (h.valid() && filter.is_a(h)) {
                     // Outward rays can never meet the convex A again. Inward rays of the closed
                     // sphere reach A's far side just behind C (within a few ulps of t: a tie, not
@@ -782,7 +822,7 @@ public:
                 const float wt = weight * max_component(kt);
                 if (!is_black(kt) && wt >= m_s.min_weight) {
                     Ray t;
-                    t.org = offset_ray_origin(sp.p, sp.offset_scale, -Ng);
+                    t.org = m_accel.ray_offset().origin(sp.p, sp.offset_scale, -Ng);
                     bool transmitted = true;
                     if (c.thin) {
                         t.dir = ray.dir;
@@ -799,7 +839,7 @@ public:
                     Vec3f R = reflect(V, N);
                     if (dot(R, Ng) <= 0.f) R = reflect(V, Ng);
                     Ray r;
-                    r.org = offset_ray_origin(sp.p, sp.offset_scale, Ng);
+                    r.org = m_accel.ray_offset().origin(sp.p, sp.offset_scale, Ng);
                     r.dir = normalize(R);
                     result += kr * trace(r, RayKind::Reflection, depth + 1, secondary, wr);
                 }
@@ -811,7 +851,7 @@ public:
             const float alpha = std::clamp(m_view.material_inputs(mat, sp).base_color.w, 0.f, 1.f);
             if (alpha < 1.f) {
                 Ray behind;
-                behind.org = offset_ray_origin(sp.p, sp.offset_scale, -Ng);
+                behind.org = m_accel.ray_offset().origin(sp.p, sp.offset_scale, -Ng);
                 behind.dir = ray.dir;
                 const Color b = depth < m_s.max_depth
                                     ? trace(behind, RayKind::Refraction, depth + 1, secondary, weight * (1.f - alpha))

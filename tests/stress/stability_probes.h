@@ -46,7 +46,7 @@ bool is_closed_mesh(const Mesh& mesh);
 // 1. Self-intersection at any scale
 
 /// How secondary-ray origins are moved off a surface (p, SurfacePoint::offset_scale, unit normal):
-/// the renderer's offset_ray_origin by default.
+/// by default the backend's RayOffsetPolicy, as the renderer does.
 using OffsetFn = std::function<Vec3f(const Vec3f& p, float scale, const Vec3f& n)>;
 
 /// The offset before issue #7 (Wächter & Binder 2019 as published: 256 ulps of each coordinate,
@@ -76,7 +76,16 @@ struct SelfIntersectionConfig {
                                       ///< ulp of the largest coordinate of A (ray_offset.h)
     double neighbour_min_cos = 1e-3;  ///< neighbours are judged for rays at least this far from grazing
     uint64_t seed = 1;
-    OffsetFn offset;                  ///< empty = offset_ray_origin
+    OffsetFn offset;                  ///< empty = the backend's ray_offset() policy
+    /// Experiment (`bench stability --skip-origin`): a query that hits the origin's own primitive
+    /// (the same triangle; the sphere's root at the origin) is repeated from just beyond that hit,
+    /// as a primitive-skipping accelerator would answer it (Cycles' "self" primitive). Shadow rays
+    /// are then closest-hit queries judged like reflection rays.
+    bool skip_origin = false;
+    /// Experiment: >= 0 replaces `offset` by an origin formed in double from the double-precision
+    /// hit point, moved this many offset units along the normal, then rounded to float away from
+    /// the surface per coordinate (origin distance in [d, d + sum |n_k|] units).
+    double double_origin_ulps = -1.0;
 };
 
 /// Per ray kind: 0 reflection, 1 refraction, 2 shadow.

@@ -94,6 +94,8 @@ public:
     }
 
     std::string name() const override { return m_inner->name(); }
+    /// The planes are exact to a float rounding of t (intersect_plane): the backend's policy.
+    RayOffsetPolicy ray_offset() const override { return m_inner->ray_offset(); }
     AccelStats stats() const override {
         AccelStats s = m_inner->stats();
         s.bytes += m_planes.size() * sizeof(PlaneData);

@@ -128,6 +128,9 @@ template <typename T, typename Blas, typename SphereBlas, typename Top = BinaryI
 class TwoLevelAccelerator final : public Accelerator {
 public:
     using Accelerator::intersect;  // the batch query: the default loop (no packet traversal here)
+    RayOffsetPolicy ray_offset() const override {
+        return std::is_same_v<T, double> ? kDoubleRayOffset : kFloatRayOffset;
+    }
     using BlasBuilder = std::function<Blas(const Mesh&)>;
     using SphereBuilder = std::function<SphereBlas(SpherePrims<T>&&)>;
     using TopBuilder = std::function<Top(const std::vector<Bounds3<T>>&)>;
