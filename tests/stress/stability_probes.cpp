@@ -264,6 +264,12 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
     const int rings = 24, segments = 48;
     const double h_min = analytic || quad ? 1.0 : std::cos(kPiD / rings) * std::cos(kPiD / segments);
     const double d = gap / (s * h_min);
+    // In collapsed cases the gap can exceed the object's size (d >= 1): the inner neighbour C would
+    // have a non-positive scale (a mirrored copy outside A, which outward shadow rays crossed as
+    // well as B: the "double counts" of docs/numerical-stability.md, open item 6). There is no
+    // room for C then; it is left out and inward rays judge self-hits only.
+    const bool has_inner = quad || d < 1.0;
+    res.inner_neighbour = has_inner;
     res.gap_world = gap;
 
     Scene scene;
@@ -271,6 +277,7 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
     Vec3d quad_normal{0, 0, 1};
     if (analytic) {
         for (double f : {1.0, 1.0 + d, 1.0 - d}) {
+            if (f <= 0.0) continue;  // see has_inner below
             Sphere sp;
             sp.center = centre;
             sp.radius = s * f;
@@ -293,7 +300,8 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
         Mesh mesh = make_closed_sphere(rings, segments, cfg.smooth_normals);
         mesh.material = mat;
         scene.meshes.push_back(std::move(mesh));
-        for (double f : {1.0, 1.0 + d, 1.0 - d}) add_instance(scene, 0, placement(s * f, translation));
+        for (double f : {1.0, 1.0 + d, 1.0 - d})
+            if (f > 0.0) add_instance(scene, 0, placement(s * f, translation));  // see has_inner below
     }
     Camera cam;
     scene.cameras.push_back(cam);
@@ -464,6 +472,10 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
                 // (point error) / cos: only self-hits are judged for those rays.
                 bool neighbour_checked = std::fabs(dot(dir_d, n_exact)) >= cfg.neighbour_min_cos;
                 if (!neighbour_checked) ++res.neighbour_unchecked;
+                if (inward && !has_inner && neighbour_checked) {
+                    ++res.neighbour_unreachable;
+                    neighbour_checked = false;
+                }
                 if (inward && analytic && neighbour_checked) {
                     // A grazing inward ray can skim through the shell between A and C and leave A
                     // again without reaching C (exact geometry, from the float origin): no neighbour.

@@ -109,6 +109,7 @@ struct SelfIntersectionResult {
     std::vector<double> point_error_ulps;  ///< |SceneView p - exact surface|, ulp(max|p|), per point
     std::vector<double> normal_error_rad;  ///< angle between SceneView's Ng and the exact normal
     double gap_world = 0;             ///< the neighbours' distance (world units)
+    bool inner_neighbour = true;      ///< false when the gap exceeds the object (collapsed): no C
 };
 
 /// Surface A (tessellated unit sphere or analytic sphere) with neighbour surfaces B (outside,

@@ -265,6 +265,32 @@ TEST(StressSelfIntersection, FloatPathNeedsItsOwnPolicy) {
     EXPECT_GT(misses, 0u);
 }
 
+// In the collapsed case s = 1e-4 at t = 1e3 the 12-ulp gap is ~9 times the object's size: the
+// inner neighbour would have a negative scale (a mirrored sphere outside A, crossed by outward
+// shadow rays as well as B: transparent-shadow "double counts" that were the probe's, not the
+// accelerator's). The probe leaves it out; no shadow ray then sees two crossings.
+TEST(StressSelfIntersection, CollapsedCasesHaveNoInnerNeighbour) {
+    for (const char* accel : {"bvh", "embree"})
+        for (bool analytic : {false, true}) {
+            SelfIntersectionConfig c;
+            c.accel = accel;
+            c.surface = analytic ? ProbeSurface::AnalyticSphere : ProbeSurface::MeshSphere;
+            c.scale = 1e-4;
+            c.translation = 1e3;
+            c.points = 300;
+            c.gap_ulps = kGuaranteedGapUlps;
+            const SelfIntersectionResult r = probe_self_intersection(c);
+            EXPECT_FALSE(r.inner_neighbour) << label(c);
+            EXPECT_GT(r.rays[2], 1000u) << label(c);
+            EXPECT_EQ(r.shadow_double_counts, 0u) << label(c);
+            for (int k = 0; k < 3; ++k) EXPECT_EQ(r.self_hits[k], 0u) << label(c) << " kind " << k;
+        }
+    SelfIntersectionConfig resolvable_case;  // C is there whenever the object is resolvable
+    resolvable_case.scale = 1e-2;
+    resolvable_case.points = 50;
+    EXPECT_TRUE(probe_self_intersection(resolvable_case).inner_neighbour);
+}
+
 // Stress 7: the integrator's float hit point (SceneView, after the Embree or in-house float hit)
 // against the exact point of the double-precision reference; error in ulp(max|p|).
 TEST(StressHitError, FloatHitPointsWithinFewUlps) {
