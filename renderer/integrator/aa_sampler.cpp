@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "renderer/core/error.h"
 
@@ -62,6 +64,55 @@ float aa_contrast(const Color& a, const Color& b, const Color& c, const Color& d
         contrast = std::max(contrast, aa_display_value(hi) - aa_display_value(lo));
     }
     return contrast;
+}
+
+namespace {
+
+/// Bounds on the slope of aa_display_value() between two clamped values, by binary exponent.
+/// The curve's derivative is 12.92 on the linear segment (v <= 0.0031308) and
+/// (1.055 / 2.4) v^(1/2.4 - 1) above it, falling from 12.70 to 0.4396 at v = 1, so on [lo, hi]:
+/// - the slope is at most 12.92, and at most f'(lo) when lo is above the linear segment;
+///   kSlopeAbove[u] bounds it for lo in [2^-(u+1), 2^-u) (u = 8: anything below 2^-8, 12.92);
+/// - the slope is at least f'(hi); kSlopeBelow[m] bounds it for hi in [2^-m, 2^-(m-1)) (m = 0:
+///   hi = 1, f'(1); m >= 10: hi below 2^-9, inside the linear segment, 12.92).
+/// Values f'(2^-k) from the formula in double precision, widened by 0.1 % (upper x 1.001, lower
+/// x 0.999) for the float constants of aa_display_value().
+constexpr float kSlopeAbove[9] = {0.659289f, 0.987818f, 1.480055f, 2.217577f, 3.322611f,
+                                  4.978291f, 7.459009f, 11.175885f, 12.93292f};
+constexpr float kSlopeBelow[11] = {0.439144f, 0.439144f, 0.657972f, 0.985844f, 1.477098f, 2.213146f,
+                                   3.315972f, 4.968344f, 7.444106f, 11.153556f, 12.90708f};
+/// Absolute slack for everything the slope bounds leave out: powf's error (< 1 ulp), the rounding
+/// of the formula and of the bound's own product, the curve's jump of ~3e-8 at 0.0031308 (the two
+/// segments do not quite meet). All are below 1e-6 on values in [0, 1].
+constexpr float kSlack = 1e-5f;
+
+/// Biased binary exponent of a non-negative float (0 for 0).
+int biased_exponent(float v) {
+    uint32_t bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    return int(bits >> 23);
+}
+
+}  // namespace
+
+bool aa_exceeds(const Color& a, const Color& b, const Color& c, const Color& d, float threshold) {
+    // aa_contrast() starts from 0 and takes maxima, so it is >= 0: a negative threshold always splits.
+    if (threshold < 0.f) return true;
+    for (int i = 0; i < 3; ++i) {
+        const float lo = std::min(std::min(a[i], b[i]), std::min(c[i], d[i]));
+        const float hi = std::max(std::max(a[i], b[i]), std::max(c[i], d[i]));
+        if (hi == lo) continue;  // aa_contrast() skips flat channels
+        // aa_contrast()'s channel term is f(hi) - f(lo) for the clamped values: bound it by the
+        // slope bounds times their difference, and evaluate it only when the bounds straddle the threshold.
+        const float clo = std::clamp(lo, 0.f, 1.f), chi = std::clamp(hi, 0.f, 1.f);
+        const float span = chi - clo;
+        const float above = kSlopeAbove[std::clamp(126 - biased_exponent(clo), 0, 8)] * span + kSlack;
+        if (above <= threshold) continue;
+        const float below = kSlopeBelow[std::clamp(127 - biased_exponent(chi), 0, 10)] * span - kSlack;
+        if (below > threshold) return true;
+        if (aa_display_value(hi) - aa_display_value(lo) > threshold) return true;
+    }
+    return false;
 }
 
 float sample_tent(float u) {

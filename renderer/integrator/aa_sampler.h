@@ -51,6 +51,9 @@ int stratified_side(int spp);
 float aa_display_value(float linear);
 /// Contrast of a square: max over channels of (max - min) of its corners' display values.
 float aa_contrast(const Color& a, const Color& b, const Color& c, const Color& d);
+/// The adaptive split test, exactly `aa_contrast(a, b, c, d) > threshold`, but deciding most
+/// squares from bounds on the sRGB curve's slope without evaluating it (no pow()).
+bool aa_exceeds(const Color& a, const Color& b, const Color& c, const Color& d, float threshold);
 
 /// Offset in [-1, 1] distributed as a tent (triangle) filter of radius 1, from u in [0, 1).
 float sample_tent(float u);

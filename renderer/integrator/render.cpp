@@ -340,6 +340,20 @@ public:
         }
         for (int y = r.y0; y < r.y1; ++y)
             for (int x = r.x0; x < r.x1; ++x) {
+                // Most pixels do not split: decide that from the lattice alone and skip the grid.
+                // What refine() and combine() would give for them: the mean of the 4 corners (area 1),
+                // 4 points, no edge point to hand over.
+                const Color& c00 = corner(x, y);
+                const Color& c10 = corner(x + 1, y);
+                const Color& c01 = corner(x, y + 1);
+                const Color& c11 = corner(x + 1, y + 1);
+                if (m_aa.depth == 0 || !aa_exceeds(c00, c10, c01, c11, m_aa.threshold)) {
+                    const auto below = scratch.bottom_valid.begin() + std::ptrdiff_t(size_t(x - r.x0) * inner);
+                    std::fill_n(scratch.right_valid.begin(), inner, uint8_t(0));
+                    std::fill_n(below, inner, uint8_t(0));
+                    finish_pixel(x, y, (c00 + c10 + c01 + c11) * 0.25f, 4.f, nullptr, rc);
+                    continue;
+                }
                 if (++scratch.generation == 0) {  // wrapped: invalidate every stamp once
                     std::fill(scratch.stamp.begin(), scratch.stamp.end(), 0u);
                     std::fill(scratch.split.begin(), scratch.split.end(), 0u);
@@ -380,7 +394,7 @@ private:
         ++p.points;
         const int n = m_n;
         const bool on_x = i == 0 || i == n, on_y = j == 0 || j == n;
-        if (on_x && on_y) s.value[k] = corner(p.x + i / n, p.y + j / n);
+        if (on_x && on_y) s.value[k] = corner(p.x + (i == n), p.y + (j == n));
         else if (on_x || on_y) {
             if (!edge_point(p, s, rc, i, j, s.value[k])) queue(p, s, rc, i, j);
         } else {
@@ -481,8 +495,8 @@ private:
             s.next.clear();
             for (const int sq : s.squares) {
                 const int i = sq % stride, j = sq / stride;
-                if (!(aa_contrast(value(i, j), value(i + size, j), value(i, j + size), value(i + size, j + size)) >
-                      m_aa.threshold))
+                if (!aa_exceeds(value(i, j), value(i + size, j), value(i, j + size), value(i + size, j + size),
+                                m_aa.threshold))
                     continue;
                 if (level == 0) p.split = true;
                 s.split[size_t((j + h) * stride + i + h)] = s.generation;

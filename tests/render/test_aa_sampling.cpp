@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <memory>
+#include <random>
 #include <set>
 #include <utility>
 #include <vector>
@@ -321,6 +322,47 @@ TEST(AaSampling, AovsComeFromThePixelCentreInEveryMode) {
         }
     }
     for (float n : want.aa_samples) ASSERT_EQ(n, 1.f);
+}
+
+TEST(AaSampling, SplitTestEqualsTheContrastAgainstTheThreshold) {
+    // aa_exceeds() decides most squares from slope bounds of the sRGB curve; it must answer exactly
+    // aa_contrast() > threshold, including thresholds equal to (or one ulp around) the contrast
+    // itself, values beyond [0, 1], both sides of the curve's linear segment, flat channels.
+    std::mt19937 rng(6);
+    std::uniform_real_distribution<float> unit(0.f, 1.f);
+    auto value = [&](float base) -> float {
+        switch (rng() % 6) {
+            case 0: return base;                                          // flat against the base
+            case 1: return base + (unit(rng) - 0.5f) * 1e-3f;             // barely different
+            case 2: return base + (unit(rng) - 0.5f) * 0.05f;             // near the thresholds
+            case 3: return unit(rng) * 0.01f;                             // around 0.0031308
+            case 4: return unit(rng) * 1.5f - 0.1f;                       // clamped at both ends
+            default: return unit(rng);
+        }
+    };
+    const float thresholds[] = {-0.1f, 0.f, 1e-6f, 1e-4f, 0.0125f, 0.025f, 0.05f, 0.1f, 0.2f, 0.5f, 1.f};
+    int nonflat = 0, splits = 0, checks = 0;
+    for (int n = 0; n < 200000; ++n) {
+        const float base = rng() % 4 == 0 ? unit(rng) * 0.006f : unit(rng);
+        Color corner[4];
+        for (Color& c : corner) c = Color(value(base), value(base), value(base));
+        const float contrast = aa_contrast(corner[0], corner[1], corner[2], corner[3]);
+        auto check = [&](float t) {
+            const bool want = contrast > t;
+            ASSERT_EQ(aa_exceeds(corner[0], corner[1], corner[2], corner[3], t), want)
+                << "contrast " << contrast << " threshold " << t << " corners " << corner[0][0] << " " << corner[1][0]
+                << " " << corner[2][0] << " " << corner[3][0];
+            splits += want;
+            ++checks;
+        };
+        for (float t : thresholds) check(t);
+        for (float t : {contrast, std::nextafter(contrast, -1.f), std::nextafter(contrast, 2.f)}) check(t);
+        nonflat += contrast > 0.f;
+    }
+    // Both answers occur often, so the comparison above tested something.
+    EXPECT_GT(splits, checks / 10);
+    EXPECT_LT(splits, checks - checks / 10);
+    EXPECT_GT(nonflat, 1000);
 }
 
 TEST(AaSampling, BadSettingsAreErrors) {
