@@ -278,7 +278,12 @@ namespace {
 /// odd ones; w <= 0 point-samples it. The integral of the odd-cell indicator is the ramp
 /// I(x) = floor(x/2) + 2 max(x/2 - floor(x/2) - 1/2, 0) (pbrt-v3, Checkerboard2DTexture).
 double filtered_square_wave(double x, double w) {
-    if (!(w > 1e-6)) return std::fmod(std::abs(std::floor(x)), 2.0) < 0.5 ? 1.0 : -1.0;
+    if (!(w > 1e-6)) {
+        // +1 on even cells: floor(x) / 2 is an integer (exact: halving an integer-valued double;
+        // the libm fmod this replaces was a call per axis and hit).
+        const double half = std::abs(std::floor(x)) * 0.5;
+        return half == std::floor(half) ? 1.0 : -1.0;
+    }
     if (w >= 2.0) return 0.0;  // the footprint covers whole periods (near enough): the mean
     auto ramp = [](double y) {
         const double h = y / 2.0, f = std::floor(h);
@@ -307,8 +312,13 @@ Color sample_checker(const Checker& c, Vec2f uv, const Vec3f& p, const Vec3f& n,
         const float step = std::max(1e-4f * c.size, 16.f * p_max * std::numeric_limits<float>::epsilon());
         const Vec3d q = (Vec3d(p) - Vec3d(n) * double(step)) * inv;
         if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) return c.color_a;
-        for (int i = 0; i < 3; ++i)
-            product *= filtered_square_wave(q[i], w * std::sqrt(std::max(0.0, 1.0 - double(n[i]) * double(n[i]))));
+        for (int i = 0; i < 3; ++i) {
+            // Axis-aligned faces (the common case: floors and walls) need no square root: the
+            // factor is exactly 1 along the face and 0 along its normal.
+            const double ni = double(n[i]);
+            const double along = ni == 0.0 ? 1.0 : std::abs(ni) == 1.0 ? 0.0 : std::sqrt(std::max(0.0, 1.0 - ni * ni));
+            product *= filtered_square_wave(q[i], w * along);
+        }
     } else {
         const double s = double(uv.x) * inv, t = double(uv.y) * inv;
         if (!std::isfinite(s) || !std::isfinite(t)) return c.color_a;

@@ -34,6 +34,7 @@
 // double-precision backends need only half an ulp, which reaches 4-ulp neighbours.
 #pragma once
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -47,10 +48,12 @@ namespace detail {
 constexpr float kOffsetUlps = 4.f;  ///< distance moved along the normal, in ulps of max(max|p|, scale)
 
 /// Spacing of floats at max(max|p|, scale): 2^(exponent - 23), at least FLT_MIN.
+/// std::max, not std::fmax: without -ffinite-math-only fmaxf is a libm call on every secondary
+/// ray (it only differs for NaN, where the origin is NaN anyway).
 inline float offset_unit(const Vec3f& p, float scale) {
-    const float m = std::fmax(std::fmax(std::fabs(p.x), scale), std::fmax(std::fabs(p.y), std::fabs(p.z)));
+    const float m = std::max(std::max(std::fabs(p.x), scale), std::max(std::fabs(p.y), std::fabs(p.z)));
     const float binade = std::bit_cast<float>(std::bit_cast<uint32_t>(m) & 0x7f800000u);  // 2^exponent
-    return std::fmax(binade * 0x1p-23f, std::numeric_limits<float>::min());
+    return std::max(binade * 0x1p-23f, std::numeric_limits<float>::min());
 }
 
 /// x moved by one float step in the direction of `dir` (never into the denormals: from 0 the

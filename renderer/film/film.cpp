@@ -1,6 +1,7 @@
 #include "renderer/film/film.h"
 
-#include <cmath>
+#include <bit>
+#include <cstdint>
 
 #include "renderer/core/error.h"
 
@@ -20,20 +21,31 @@ Film::Film(int full_width_, int full_height_, PixelWindow window_, AovSet aovs_)
 
 namespace {
 
+/// NaN or infinity: all exponent bits set. A bit test rather than std::isfinite, component by
+/// component without Vec3::operator[]'s branches, so the loops below vectorise: the whole-film
+/// pass after every render was ~0.4% of the time of a whitted1980 render.
+inline bool nonfinite(float x) { return (std::bit_cast<uint32_t>(x) & 0x7f800000u) == 0x7f800000u; }
+
 template <typename V>
 size_t count_nonfinite(const std::vector<V>& buffer) {
+    // The components as one float array (Vec3<float> is three packed floats, as the output writes it).
+    static_assert(sizeof(V) == 3 * sizeof(float));
+    const float* f = reinterpret_cast<const float*>(buffer.data());
     size_t n = 0;
-    for (const V& v : buffer)
-        for (int k = 0; k < 3; ++k) n += !std::isfinite(v[k]);
+    for (size_t i = 0, size = buffer.size() * 3; i < size; ++i) n += nonfinite(f[i]);
     return n;
 }
 
 template <typename V>
 size_t zero_nonfinite(std::vector<V>& buffer) {
-    size_t n = 0;
-    for (V& v : buffer)
-        for (int k = 0; k < 3; ++k)
-            if (!std::isfinite(v[k])) v[k] = 0.f, ++n;
+    // Counted first (vectorised); the buffer is only written when something needs repair.
+    const size_t n = count_nonfinite(buffer);
+    if (n == 0) return 0;
+    for (V& v : buffer) {
+        if (nonfinite(v.x)) v.x = 0.f;
+        if (nonfinite(v.y)) v.y = 0.f;
+        if (nonfinite(v.z)) v.z = 0.f;
+    }
     return n;
 }
 

@@ -82,6 +82,22 @@ SceneView::SceneView(const Scene& scene, const MappingOptions& mapping)
             for (int c = 0; c < 3; ++c) m_xf[i].n[r * 3 + c] = float(inv_t(r, c));
         }
     }
+    // Which materials read a texture through UVs. The scene file's world-space checker (Whitted's
+    // floor) reads the position, normal and footprint only: its hits skip the UV interpolation,
+    // the sphere's atan2/acos and the log2 of the MIP level.
+    m_needs_uv.resize(scene.materials.size());
+    for (size_t i = 0; i < scene.materials.size(); ++i) {
+        const Material& m = scene.materials[i];
+        if (m.model != MaterialModel::Classic) {
+            m_needs_uv[i] = 1;  // glTF textures are all UV-mapped (conservative for untextured ones)
+            continue;
+        }
+        const TextureRef& ref = m.classic_color_texture;
+        const bool world_checker = ref.valid() && size_t(ref.texture) < scene.textures.size() &&
+                                   scene.textures[size_t(ref.texture)].kind == TextureKind::Checker &&
+                                   scene.textures[size_t(ref.texture)].checker.world_space;
+        m_needs_uv[i] = ref.valid() && !world_checker;
+    }
     // What each geometry (meshes, spheres, planes) needs from traversal.
     m_mesh_flags.resize(scene.geometry_count());
     for (uint32_t g = 0; g < scene.geometry_count(); ++g) {
@@ -164,8 +180,9 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
 
     // Texture and vertex-color inputs: skipped when nothing in the scene varies over a surface.
     if constexpr (kAttributes) {
-        if (!mesh.uv0.empty()) sp.uv[0] = interpolate(mesh.uv0, i0, i1, i2, u, v);
-        if (!mesh.uv1.empty()) sp.uv[1] = interpolate(mesh.uv1, i0, i1, i2, u, v);
+        const bool uvs = m_needs_uv[mesh.material] != 0;
+        if (uvs && !mesh.uv0.empty()) sp.uv[0] = interpolate(mesh.uv0, i0, i1, i2, u, v);
+        if (uvs && !mesh.uv1.empty()) sp.uv[1] = interpolate(mesh.uv1, i0, i1, i2, u, v);
         if (!mesh.colors.empty()) sp.color = interpolate(mesh.colors, i0, i1, i2, u, v);
 
         // Texture footprint (Akenine-Moeller et al. 2019, ray cones): the cone's width at the hit,
@@ -173,9 +190,9 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
         // of the triangle (its UV parameterisation's mean scale). Isotropic: no anisotropic filtering.
         const float width = cone.width_at(hit.t);
         if (width > 0.f) {
-            const float world_area = length(cross(p1 - p0, p2 - p0));
             const float cos_theta = std::max(std::abs(dot(ng, ray.dir)), 1e-3f);
             sp.footprint = width / cos_theta;
+            const float world_area = uvs ? length(cross(p1 - p0, p2 - p0)) : 0.f;
             auto footprint = [&](const std::vector<Vec2f>& uvs) {
                 const Vec2f a = uvs[i0], b = uvs[i1], c = uvs[i2];
                 const float uv_area = std::abs((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y));
@@ -183,8 +200,8 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
                 const float lod = std::log2(width / cos_theta) + 0.5f * std::log2(uv_area / world_area);
                 return std::isfinite(lod) ? lod : -kInfinity;
             };
-            if (!mesh.uv0.empty()) sp.uv_lod[0] = footprint(mesh.uv0);
-            if (!mesh.uv1.empty()) sp.uv_lod[1] = footprint(mesh.uv1);
+            if (uvs && !mesh.uv0.empty()) sp.uv_lod[0] = footprint(mesh.uv0);
+            if (uvs && !mesh.uv1.empty()) sp.uv_lod[1] = footprint(mesh.uv1);
         }
     }
 
@@ -232,17 +249,21 @@ SurfacePoint SceneView::sphere_surface(const Ray& ray, const Hit& hit, const Ray
     sp.offset_scale = float(sphere.radius);
     sp.ng = sp.ns = normalize(Vec3f(n));
     if constexpr (!kAttributes) return sp;
-    // Longitude about +Y and colatitude from the +Y pole (scene.h: Sphere).
-    const double u = std::atan2(n.x, n.z) / (2.0 * kPiD) + 0.5;
-    const double v = std::acos(std::clamp(n.y, -1.0, 1.0)) / kPiD;
-    sp.uv[0] = sp.uv[1] = Vec2f{float(u), float(v)};
+    const bool uvs = m_needs_uv[sphere.material] != 0;
+    if (uvs) {
+        // Longitude about +Y and colatitude from the +Y pole (scene.h: Sphere).
+        const double u = std::atan2(n.x, n.z) / (2.0 * kPiD) + 0.5;
+        const double v = std::acos(std::clamp(n.y, -1.0, 1.0)) / kPiD;
+        sp.uv[0] = sp.uv[1] = Vec2f{float(u), float(v)};
+    }
     const float width = cone.width_at(hit.t);
     if (width > 0.f) {
+        const float cos_theta = std::max(std::abs(dot(sp.ng, ray.dir)), 1e-3f);
+        sp.footprint = width / cos_theta;
+        if (!uvs) return sp;
         // One UV unit spans 2 pi r sin(theta) (u) by pi r (v) world units: mean scale
         // sqrt(1 / (2 pi^2 r^2 sin(theta))), sin(theta) clamped near the poles.
         const double sin_theta = std::max(std::sqrt(std::max(0.0, 1.0 - n.y * n.y)), 1e-3);
-        const float cos_theta = std::max(std::abs(dot(sp.ng, ray.dir)), 1e-3f);
-        sp.footprint = width / cos_theta;
         const double area = 2.0 * kPiD * kPiD * sphere.radius * sphere.radius * sin_theta;
         const float lod = std::log2(width / cos_theta) - float(0.5 * std::log2(area));
         sp.uv_lod[0] = sp.uv_lod[1] = std::isfinite(lod) ? lod : -kInfinity;
@@ -267,14 +288,18 @@ SurfacePoint SceneView::plane_surface(const Ray& ray, const Hit& hit, const RayC
     sp.offset_scale = float(max_abs(plane.point)) * 0x1p-26f;
     sp.ng = sp.ns = Vec3f(plane.normal);
     if constexpr (!kAttributes) return sp;
-    const Vec3d rel = p - plane.point;
-    const Vec3d v_axis = cross(plane.normal, plane.u_axis);
-    sp.uv[0] = sp.uv[1] = Vec2f{float(dot(rel, plane.u_axis)), float(dot(rel, v_axis))};
+    const bool uvs = m_needs_uv[plane.material] != 0;
+    if (uvs) {
+        const Vec3d rel = p - plane.point;
+        const Vec3d v_axis = cross(plane.normal, plane.u_axis);
+        sp.uv[0] = sp.uv[1] = Vec2f{float(dot(rel, plane.u_axis)), float(dot(rel, v_axis))};
+    }
     const float width = cone.width_at(hit.t);
     if (width > 0.f) {
         // UV units are world units.
         const float cos_theta = std::max(std::abs(dot(sp.ng, ray.dir)), 1e-3f);
         sp.footprint = width / cos_theta;
+        if (!uvs) return sp;
         const float lod = std::log2(sp.footprint);
         sp.uv_lod[0] = sp.uv_lod[1] = std::isfinite(lod) ? lod : -kInfinity;
     }

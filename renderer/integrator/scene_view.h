@@ -55,7 +55,9 @@ public:
     /// kAttributes = false skips what only textures and vertex colors need (UVs, COLOR_0, the
     /// footprint, normal maps): p, p_shadow, ng and ns are the same, uv/color/uv_lod/footprint
     /// keep their defaults. Only valid when no material the hit can use is varying
-    /// (SceneAnalysis::features.varying is false).
+    /// (SceneAnalysis::features.varying is false). With kAttributes, uv and uv_lod also keep their
+    /// defaults when the hit's material reads no texture through UVs (none, or a world-space
+    /// checker, which reads p, ng and footprint).
     template <bool kAttributes = true>
     SurfacePoint surface(const Ray& ray, const Hit& hit, const RayCone& cone = {}) const;
     /// Material inputs at a point (factors x textures x vertex color).
@@ -93,6 +95,8 @@ private:
     MappingOptions m_mapping;
     std::vector<InstanceXf> m_xf;
     std::vector<uint32_t> m_mesh_flags;
+    std::vector<uint8_t> m_needs_uv;  ///< per material: some texture is read through UVs (not a
+                                      ///< world-space checker); 0 = surface() skips UVs and MIP levels
     SceneAnalysis m_analysis;
 };
 

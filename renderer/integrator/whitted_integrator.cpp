@@ -408,14 +408,19 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
     // no UVs, colors or footprint, and its coefficients come from the analysis' table (the same
     // mapping, evaluated once at load).
     const MaterialFeatures& mf = m_view.analysis().materials[scene.geom_material(hit.geom)];
-    SurfacePoint sp;
-    if constexpr (!K.attributes) sp = m_view.surface<false>(ray, hit, cone);
-    else if constexpr (!K.tables) sp = m_view.surface<true>(ray, hit, cone);
-    else sp = mf.varying ? m_view.surface<true>(ray, hit, cone) : m_view.surface<false>(ray, hit, cone);
-    WhittedCoeffs c;
-    if constexpr (!K.tables) c = m_view.coefficients(sp);
-    else if constexpr (!K.attributes) c = mf.constant;
-    else c = mf.varying ? m_view.coefficients(sp) : mf.constant;
+    // Both built in place: no default-constructed SurfacePoint to overwrite, and a constant
+    // material's coefficients are read from the table, not copied (~100 bytes per hit each).
+    const SurfacePoint sp = [&] {
+        if constexpr (!K.attributes) return m_view.surface<false>(ray, hit, cone);
+        else if constexpr (!K.tables) return m_view.surface<true>(ray, hit, cone);
+        else return mf.varying ? m_view.surface<true>(ray, hit, cone) : m_view.surface<false>(ray, hit, cone);
+    }();
+    WhittedCoeffs varying;
+    const WhittedCoeffs& c = [&]() -> const WhittedCoeffs& {
+        if constexpr (!K.tables) return varying = m_view.coefficients(sp);
+        else if constexpr (!K.attributes) return mf.constant;
+        else return mf.varying ? (varying = m_view.coefficients(sp)) : mf.constant;
+    }();
     const Material& mat = scene.materials[sp.material];
     // Secondary rays start where this cone arrived and keep its spread. Surface curvature would
     // widen (convex mirrors) or narrow it; it is ignored (flat-surface propagation).
@@ -453,7 +458,10 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
     if (!unlit) {
         // Local model: I = Ia Ka + sum_i Is_i fat_i s_i (kd (N.L) + ks (N.H)^n).
         result += m_settings.ambient * c.ka;
-        const Vec3f shadow_org = m_offset.origin(front ? sp.p_shadow : sp.p, sp.offset_scale, Ng);
+        // The shadow-ray origin, computed at the first light that passes the tests below (a point
+        // that no light reaches or faces casts no shadow ray and needs none).
+        Vec3f shadow_org;
+        bool have_shadow_org = false;
         const bool diffuse_or_specular = !is_black(c.kd) || !is_black(c.ks);
         auto add_light = [&](const Light& light) {
             LightSample ls = sample_light(light, sp.p);
@@ -467,6 +475,10 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
             if (n_dot_l <= 0.f) {
                 ++counters.shadow_skipped_facing;
                 return;
+            }
+            if (!have_shadow_org) {
+                shadow_org = m_offset.origin(front ? sp.p_shadow : sp.p, sp.offset_scale, Ng);
+                have_shadow_org = true;
             }
             Ray shadow;
             shadow.org = shadow_org;

@@ -402,5 +402,61 @@ TEST(Specialization, SpecialisedKernelIsDeterministicAcrossThreadsAndTiles) {
     EXPECT_TRUE(same_image(a, b));
 }
 
+// SceneView::surface<true> leaves UVs and MIP levels at their defaults for a material that reads
+// no texture through UVs (the world-space checker reads p, ng and the footprint): the same
+// coefficients as with the UVs computed, while a UV-space checker on the same mesh still gets them.
+TEST(SurfaceAttributes, WorldSpaceCheckerSkipsUvsOnly) {
+    Scene scene;
+    for (const bool world : {true, false}) {
+        Texture t;
+        t.kind = TextureKind::Checker;
+        t.checker.color_a = {0.9f, 0.1f, 0.1f};
+        t.checker.color_b = {0.1f, 0.1f, 0.9f};
+        t.checker.size = 0.3f;
+        t.checker.world_space = world;
+        scene.textures.push_back(t);
+        WhittedCoeffs c;
+        c.kd = Color(0.8f);
+        add_classic_material(scene, c, world ? "world" : "uv");
+        scene.materials.back().classic_color_texture.texture = int32_t(scene.textures.size() - 1);
+    }
+    for (uint32_t material : {0u, 1u}) {
+        Mesh quad = make_quad({-2.f, 0.f, 2.f}, {2.f, 0.f, 2.f}, {2.f, 0.f, -2.f}, {-2.f, 0.f, -2.f}, material);
+        quad.uv0 = {{0.f, 0.f}, {1.f, 0.f}, {1.f, 1.f}, {0.f, 1.f}};
+        add_mesh(scene, quad);
+    }
+    const SceneView view(scene, MappingOptions{});
+    Ray ray;
+    ray.org = {0.35f, 3.f, 0.2f};
+    ray.dir = normalize(Vec3f{0.1f, -1.f, -0.05f});
+    const RayCone cone{0.f, 0.01f};
+    for (uint32_t mesh : {0u, 1u}) {
+        Hit hit;
+        hit.geom = mesh;
+        hit.inst = mesh;
+        hit.prim = 0;
+        hit.t = 3.f / -ray.dir.y;
+        hit.u = 0.3f;
+        hit.v = 0.2f;
+        const SurfacePoint sp = view.surface<true>(ray, hit, cone);
+        const SurfacePoint flat = view.surface<false>(ray, hit, cone);
+        EXPECT_EQ(sp.p, flat.p);
+        EXPECT_EQ(sp.ng, flat.ng);
+        EXPECT_EQ(sp.ns, flat.ns);
+        EXPECT_GT(sp.footprint, 0.f);
+        if (mesh == 0) {  // world-space checker: no UVs, no MIP level, and none needed
+            EXPECT_EQ(sp.uv[0], (Vec2f{0.f, 0.f}));
+            EXPECT_EQ(sp.uv_lod[0], -kInfinity);
+            SurfacePoint with_uv = sp;
+            with_uv.uv[0] = {0.55f, 0.45f};
+            with_uv.uv_lod[0] = -3.f;
+            EXPECT_EQ(view.coefficients(sp).kd, view.coefficients(with_uv).kd);
+        } else {  // UV-space checker: interpolated UVs and a finite MIP level
+            EXPECT_NE(sp.uv[0], (Vec2f{0.f, 0.f}));
+            EXPECT_GT(sp.uv_lod[0], -kInfinity);
+        }
+    }
+}
+
 }  // namespace
 }  // namespace whitted

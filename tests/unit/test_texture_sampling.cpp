@@ -356,6 +356,18 @@ TEST(Checker, UvPointSamplesAlternate) {
     EXPECT_EQ(sample_checker(c, {-0.1f, -0.1f}, {}, {}), c.color_a); // cell (-1, -1)
 }
 
+TEST(Checker, UvPointSampleParityFarFromTheOrigin) {
+    // The unfiltered parity test (floor(x) even or odd) at cell indices that need all of a float's
+    // bits, on both sides of zero, and beyond 2^53, where every double is an even integer.
+    const Checker c = red_yellow(false);
+    for (const int64_t k : {int64_t(2097151), int64_t(2097150), int64_t(-2097151), int64_t(-2097152)}) {
+        const Vec2f uv{(float(k) + 0.5f) * c.size, 0.25f * c.size};  // exact in float; v in cell 0
+        EXPECT_EQ(sample_checker(c, uv, {}, {}), k % 2 == 0 ? c.color_a : c.color_b) << k;
+    }
+    EXPECT_EQ(sample_checker(c, {3e30f, 0.25f * c.size}, {}, {}), c.color_a);
+    EXPECT_EQ(sample_checker(c, {-3e30f, 0.25f * c.size}, {}, {}), c.color_a);
+}
+
 TEST(Checker, WorldSpaceFloorOnCellBoundaryDoesNotFlicker) {
     // A floor at y = 0 lies exactly on a cell boundary of the 3D checker; every point of it must
     // pick the same y cell, so the pattern is a clean 2D checkerboard in x and z.
