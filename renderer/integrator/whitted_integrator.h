@@ -56,8 +56,9 @@ std::string kernel_name(const KernelFeatures& k);
 /// cannot reach the point (beyond its range, outside its cone or culled per object by the scene
 /// analysis: `unreached`) or lies behind the surface (N.L <= 0: `facing`), and secondary rays
 /// not traced because their weight fell below min_weight (`cutoff`). `contact_probe` counts the
-/// short queries for a touching dielectric's coincident face (in the integrator's own small
-/// structure, not the scene's accelerator; not in total()).
+/// short queries for a coincident face (a touching dielectric's, or an opaque surface under a thin
+/// transmissive one: in the integrator's own small structures, not the scene's accelerator; not
+/// in total()).
 struct RayCounters {
     uint64_t camera = 0, shadow = 0, reflection = 0, refraction = 0, aov_probe = 0;
     uint64_t shadow_skipped_unreached = 0, shadow_skipped_facing = 0, secondary_skipped_cutoff = 0;
@@ -86,6 +87,9 @@ struct PrimaryInfo {
 
 /// Where non-thin dielectrics of a scene touch (coincident faces): see whitted_integrator.cpp.
 class DielectricContacts;
+/// Where opaque surfaces coincide with thin transmissive ones (a transparent box standing on a
+/// floor): see whitted_integrator.cpp.
+class OpaqueCovers;
 
 class WhittedIntegrator {
 public:
@@ -158,6 +162,9 @@ private:
     };
     /// Looks for it at a hit on a non-thin dielectric (out of line, off the kernels' hot path).
     std::optional<OtherMedium> other_medium(const Hit& hit, const SurfacePoint& sp, RayCounters& counters) const;
+    /// The opaque surface coinciding with a hit on a thin transmissive object, as a hit of the same
+    /// ray at the same t (OpaqueCovers), or nullopt (out of line, off the kernels' hot path).
+    std::optional<Hit> opaque_cover(const Ray& ray, const Hit& hit, RayCounters& counters) const;
 
     const SceneView& m_view;
     const Accelerator& m_accel;
@@ -167,6 +174,8 @@ private:
     TraceFn m_trace = nullptr;
     CameraFn m_trace_camera = nullptr;
     std::shared_ptr<const DielectricContacts> m_contacts;  ///< null when no dielectrics touch
+    std::shared_ptr<const OpaqueCovers> m_covers;          ///< null when no thin transmissive object
+                                                           ///< can touch an opaque one
 };
 
 }  // namespace whitted
