@@ -31,8 +31,6 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
-#include <xmmintrin.h>
-#include <pmmintrin.h>
 
 #include <algorithm>
 #include <array>
@@ -54,6 +52,7 @@
 #include "apps/whitted/command.h"
 #include "apps/whitted/ray_recording.h"
 #include "importers/scene_loader.h"
+#include "renderer/core/fp_mode.h"
 #include "renderer/accel/embree/embree_ray.h"
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
@@ -189,11 +188,6 @@ Measured measure(const Renderer& r, const AaSettings& aa, const IntegratorSettin
 
 // ---- ray recording and replay (the Whitted overhead) ----
 
-void set_ftz_daz() {
-    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-}
-
 /// Seconds to replay `rays` through `accel` in blocks of about 1024 consecutive rays on `threads`
 /// threads (median of `repeat` runs). Blocks start at query boundaries, so recorded batch queries
 /// (rows of camera rays) are replayed as batches: packets where the render used packets.
@@ -207,7 +201,7 @@ double replay_seconds(const Accelerator& accel, const std::vector<RecordedRay>& 
     for (int run = 0; run < std::max(1, repeat); ++run) {
         const double start = clock_now();
         tbb::parallel_for(tbb::blocked_range<size_t>(0, starts.size() - 1), [&](const tbb::blocked_range<size_t>& r) {
-            set_ftz_daz();
+            const ScopedFlushDenormals ftz;  // the mode the render traces in
             std::vector<Ray> batch;
             std::vector<Hit> hits;
             float sink = 0.f;
@@ -228,6 +222,7 @@ double replay_seconds(const Accelerator& accel, const std::vector<RecordedRay>& 
 /// kernels); otherwise trace() ray by ray. Returns the radiance per pixel, row-major.
 std::vector<Color> camera_pass(const CameraModel& camera, const WhittedIntegrator& integrator, ImageSize size, int tile,
                                bool packets, RayCounters& rc) {
+    const ScopedFlushDenormals ftz;  // the mode the render traces in (the Renderer restores the caller's)
     std::vector<Color> image(size_t(size.width) * size_t(size.height));
     const RayCone cone = camera.pixel_cone();
     std::array<Ray, 16> rays;
@@ -376,7 +371,7 @@ private:
             const double start = clock_now();
             // Blocks of 1024 rays (a multiple of every packet width).
             tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
-                set_ftz_daz();
+                const ScopedFlushDenormals ftz;  // the mode the render traces in
                 body(r.begin(), r.end());
             });
             t.push_back(clock_now() - start);

@@ -7,7 +7,6 @@
 #include <tbb/task_scheduler_observer.h>
 #include <unistd.h>
 #include <xmmintrin.h>
-#include <pmmintrin.h>
 
 #include <algorithm>
 #include <array>
@@ -20,6 +19,7 @@
 #include <sstream>
 
 #include "renderer/core/error.h"
+#include "renderer/core/fp_mode.h"
 #include "renderer/core/log.h"
 #include "renderer/core/uninitialized.h"
 
@@ -41,18 +41,23 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-void set_ftz_daz() {
-    // Embree expects flush-to-zero and denormals-are-zero in every thread that traces.
-    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-}
-
-/// Sets FTZ/DAZ in every worker thread that enters the arena.
+/// FTZ/DAZ (renderer/core/fp_mode.h) in every thread while it works in the render's arena: set on
+/// entry, the thread's own mode restored on exit (TBB's workers serve other arenas too).
 class FtzObserver final : public tbb::task_scheduler_observer {
 public:
     explicit FtzObserver(tbb::task_arena& arena) : tbb::task_scheduler_observer(arena) { observe(true); }
     ~FtzObserver() override { observe(false); }
-    void on_scheduler_entry(bool) override { set_ftz_daz(); }
+    void on_scheduler_entry(bool) override {
+        saved_csr() = _mm_getcsr();
+        _mm_setcsr(saved_csr() | ScopedFlushDenormals::kFtz | ScopedFlushDenormals::kDaz);
+    }
+    void on_scheduler_exit(bool) override { _mm_setcsr(saved_csr()); }
+
+private:
+    static unsigned& saved_csr() {
+        thread_local unsigned csr = 0;
+        return csr;
+    }
 };
 
 /// Progress bar with ETA on stderr, redrawn at most every 200 ms by whichever worker gets there.
@@ -130,9 +135,11 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
 
     validate_aa_settings(settings.aa);
 
-    set_ftz_daz();
     auto start = Clock::now();
-    m_accel = create_accelerator(settings.accel, scene, m_view, AccelConfig{settings.robust, settings.threads});
+    {
+        const ScopedFlushDenormals ftz;  // the build in the tracing mode, the caller's mode after it
+        m_accel = create_accelerator(settings.accel, scene, m_view, AccelConfig{settings.robust, settings.threads});
+    }
     m_build_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     const AccelStats as = m_accel->stats();
     log_info("accelerator: {}{}, built in {:.3f}s, {:.1f} MiB", m_accel->name(),
@@ -592,7 +599,7 @@ Film Renderer::render(const AaSettings& aa, const IntegratorSettings& settings, 
     const int threads = m_settings.threads > 0 ? m_settings.threads : tbb::this_task_arena::max_concurrency();
     tbb::task_arena arena(threads);
     FtzObserver observer(arena);
-    set_ftz_daz();
+    const ScopedFlushDenormals ftz;  // this thread traces too (arena.execute); restored on return
 
     // Runs `body(tile rectangle, counters)` over every tile in parallel.
     auto for_each_tile = [&](auto&& body) {

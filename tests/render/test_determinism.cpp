@@ -5,6 +5,7 @@
 #include <cstring>
 #include <vector>
 
+#include "renderer/core/fp_mode.h"
 #include "renderer/integrator/render.h"
 #include "tests/support/scene_builder.h"
 
@@ -148,6 +149,36 @@ TEST(Determinism, CropRendersTheSamePixelsAsTheFullImage) {
     ASSERT_EQ(crop.height(), 35);
     for (int y = 5; y < 40; ++y)
         for (int x = 10; x < 60; ++x) ASSERT_EQ(crop.beauty[crop.index(x, y)], full.beauty[full.index(x, y)]);
+}
+
+// The renderer traces with flush-to-zero / denormals-are-zero (renderer/core/fp_mode.h) but is a
+// library: the calling thread's floating-point mode must be the same after constructing a Renderer
+// and after render() (with 1 and 2 threads; the caller's thread works in the arena too), and
+// denormal arithmetic must work again afterwards. Setting FTZ/DAZ and leaving it set fails this.
+TEST(Determinism, RendererRestoresTheCallersFloatingPointMode) {
+    const Scene s = glass_and_shadows_scene();
+    // The control bits (rounding, exception masks, FTZ, DAZ), not the sticky exception flags.
+    auto mode = [] { return _mm_getcsr() & ~0x3Fu; };
+    const unsigned before = mode();
+    ASSERT_EQ(before & (ScopedFlushDenormals::kFtz | ScopedFlushDenormals::kDaz), 0u) << "test runner set FTZ/DAZ";
+    for (int threads : {1, 2}) {
+        RenderSettings rs;
+        rs.width = 33;
+        rs.height = 21;
+        rs.threads = threads;
+        Renderer r(s, rs);
+        EXPECT_EQ(mode(), before) << "after the constructor, threads " << threads;
+        const Film film = r.render();
+        EXPECT_EQ(mode(), before) << "after render(), threads " << threads;
+    }
+    volatile float tiny = 1e-38f;  // a normal float; /100 is denormal unless flushed
+    EXPECT_GT(tiny / 100.f, 0.f);
+    {
+        const ScopedFlushDenormals ftz;
+        EXPECT_EQ(_mm_getcsr() & ScopedFlushDenormals::kFtz, ScopedFlushDenormals::kFtz);
+        EXPECT_EQ(tiny / 100.f, 0.f);  // flushed inside the scope
+    }
+    EXPECT_EQ(mode(), before);
 }
 
 }  // namespace

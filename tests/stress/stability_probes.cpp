@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "renderer/core/fp_mode.h"
 #include "renderer/accel/common/sphere.h"
 #include "renderer/core/ray_offset.h"
 #include "renderer/integrator/camera.h"
@@ -30,11 +31,6 @@ namespace whitted::stress {
 
 namespace {
 
-/// The renderer traces with flush-to-zero / denormals-are-zero on (render.cpp); so do the probes.
-void set_ftz_daz() {
-    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-}
 
 const Vec3d kTranslationDir{0.8, 0.36, -0.48};  // unit length, no component exactly representable
 
@@ -243,7 +239,7 @@ bool is_closed_mesh(const Mesh& mesh) {
 // 1. Self-intersection
 
 SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg) {
-    set_ftz_daz();
+    const ScopedFlushDenormals ftz;  // as the renderer traces (render.cpp); the caller's mode after
     SelfIntersectionResult res;
     const double s = cfg.scale;
     const bool quad = cfg.surface == ProbeSurface::TiltedQuad;
@@ -592,7 +588,7 @@ bool find_inside_point(const Mesh& m, Vec3f& inside, float& radius) {
 
 WatertightResult probe_watertight(const Mesh& mesh_in, const Vec3f& inside, float inside_radius,
                                   const WatertightConfig& cfg) {
-    set_ftz_daz();
+    const ScopedFlushDenormals ftz;  // as the renderer traces (render.cpp); the caller's mode after
     Scene scene;
     const uint32_t mat = add_material(scene);
     Mesh mesh = mesh_in;
@@ -611,7 +607,7 @@ WatertightResult probe_watertight(const Mesh& mesh_in, const Vec3f& inside, floa
     tbb::task_arena arena(cfg.threads > 0 ? cfg.threads : tbb::this_task_arena::max_concurrency());
     arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<uint64_t>(0, chunks), [&](const tbb::blocked_range<uint64_t>& range) {
-            set_ftz_daz();
+            const ScopedFlushDenormals ftz;  // as the renderer traces (render.cpp)
             for (uint64_t c = range.begin(); c != range.end(); ++c) {
                 std::mt19937_64 rng(cfg.seed * 0x9E3779B97F4A7C15ull + c);
                 std::uniform_real_distribution<double> u01(0.0, 1.0);
@@ -656,7 +652,7 @@ WatertightResult probe_watertight(const Mesh& mesh_in, const Vec3f& inside, floa
 
 HitErrorResult probe_hit_error(const std::string& accel_name, bool sphere, double s, double translation, size_t n,
                                uint64_t seed) {
-    set_ftz_daz();
+    const ScopedFlushDenormals ftz;  // as the renderer traces (render.cpp); the caller's mode after
     Scene scene;
     const uint32_t mat = add_material(scene);
     const Vec3d centre = kTranslationDir * translation;
@@ -883,7 +879,7 @@ private:
 }  // namespace
 
 EnergyResult check_energy_bound(const Scene& scene, const RenderSettings& settings_in) {
-    set_ftz_daz();
+    const ScopedFlushDenormals ftz;  // as the renderer traces (render.cpp); the caller's mode after
     RenderSettings settings = settings_in;
     settings.aa = AaSettings{};  // pixel centres: one camera ray per pixel, the one the bound follows
     const Renderer renderer(scene, settings);
