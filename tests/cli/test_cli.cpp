@@ -48,6 +48,15 @@ TEST(Cli, BadFlagValueIsOneLineAndExitTwo) {
     EXPECT_EQ(line_count(r.err), 1u) << r.err;
 }
 
+// `bench stability --accels` names backends of the self-intersection sweep: an unknown one is a
+// one-line error, not an empty table.
+TEST(Cli, BenchStabilityUnknownBackendIsOneLineAndExitTwo) {
+    Result r = run("bench stability --sections self --accels bvh,no-such-backend");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("no-such-backend"), std::string::npos) << r.err;
+}
+
 TEST(Cli, MissingSubcommandOrFileIsExitTwo) {
     EXPECT_EQ(run("").code, 2);
     EXPECT_EQ(run("render").code, 2);
