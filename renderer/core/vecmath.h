@@ -85,6 +85,8 @@ template <typename T> constexpr Vec3<T> vmax(const Vec3<T>& a, const Vec3<T>& b)
     return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
 }
 template <typename T> constexpr T max_component(const Vec3<T>& v) { return std::max(v.x, std::max(v.y, v.z)); }
+/// Largest absolute coordinate.
+template <typename T> inline T max_abs(const Vec3<T>& v) { return std::max(std::fabs(v.x), std::max(std::fabs(v.y), std::fabs(v.z))); }
 template <typename T> constexpr Vec3<T> lerp(const Vec3<T>& a, const Vec3<T>& b, T t) { return a * (T(1) - t) + b * t; }
 template <typename T> inline bool is_finite(const Vec3<T>& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);

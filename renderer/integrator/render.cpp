@@ -6,7 +6,6 @@
 #include <tbb/task_arena.h>
 #include <tbb/task_scheduler_observer.h>
 #include <unistd.h>
-#include <xmmintrin.h>
 
 #include <algorithm>
 #include <array>
@@ -15,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <sstream>
 
@@ -47,16 +47,14 @@ class FtzObserver final : public tbb::task_scheduler_observer {
 public:
     explicit FtzObserver(tbb::task_arena& arena) : tbb::task_scheduler_observer(arena) { observe(true); }
     ~FtzObserver() override { observe(false); }
-    void on_scheduler_entry(bool) override {
-        saved_csr() = _mm_getcsr();
-        _mm_setcsr(saved_csr() | ScopedFlushDenormals::kFtz | ScopedFlushDenormals::kDaz);
-    }
-    void on_scheduler_exit(bool) override { _mm_setcsr(saved_csr()); }
+    void on_scheduler_entry(bool) override { in_arena().emplace(); }
+    void on_scheduler_exit(bool) override { in_arena().reset(); }
 
 private:
-    static unsigned& saved_csr() {
-        thread_local unsigned csr = 0;
-        return csr;
+    /// This thread's mode while it works in the arena (a scope that spans entry to exit).
+    static std::optional<ScopedFlushDenormals>& in_arena() {
+        thread_local std::optional<ScopedFlushDenormals> scope;
+        return scope;
     }
 };
 

@@ -22,9 +22,6 @@ Vec3f xf_normal(const float* n, const Vec3f& v) {
             n[6] * v.x + n[7] * v.y + n[8] * v.z};
 }
 
-/// Largest absolute coordinate.
-double max_abs(const Vec3d& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
-
 template <typename T>
 T interpolate(const std::vector<T>& a, uint32_t i0, uint32_t i1, uint32_t i2, float u, float v) {
     const float w = 1.f - u - v;

@@ -87,7 +87,47 @@ constexpr KernelFeatures kKernels[] = {
 // scene (one interface with an exterior ior); production renderers ask for overlapping volumes
 // with priorities (Schmidt & Budge 2002). A mesh that can only touch itself (two glass parts in
 // one mesh) is not a candidate: candidates come from pairs of objects (DielectricContacts::find).
-class DielectricContacts final : public SurfaceFilter {
+
+/// What DielectricContacts and OpaqueCovers share: a small in-house BVH over some of the scene's
+/// objects (the faces a candidate's surface may coincide with), probed along the normal of a hit
+/// on a candidate object, with hits reported in the scene's ids. The derived class's filter
+/// decides which faces count.
+class ContactSearch : public SurfaceFilter {
+public:
+    /// True when hits on object `o` (object_index) look for a coinciding face.
+    bool candidate(uint32_t o) const { return m_candidate[o] != 0; }
+
+    Color transmittance(const Ray&, const Hit&) const override { return Color(0.f); }  // never asked
+
+protected:
+    /// Hits on the objects flagged in `candidate` (per object_index) will probe a structure over
+    /// the objects flagged in `keep` (defined below, with the object helpers).
+    void build(const Scene& scene, std::vector<uint8_t> candidate, const std::vector<uint8_t>& keep);
+
+    /// The nearest accepted face on `probe` (set here: from `reach` behind p along the unit normal
+    /// n, 2 reach long) in the scene's ids, or an invalid Hit.
+    Hit probe_at(const Vec3f& p, const Vec3f& n, float reach, Ray& probe) const {
+        probe.org = p - n * reach;
+        probe.dir = n;
+        probe.tfar = 2.f * reach;
+        Hit h = m_accel->intersect(probe, RayKind::Refraction);
+        if (!h.valid()) return h;
+        const bool mesh = h.geom < m_sub.meshes.size();
+        h.inst = mesh ? m_inst[h.inst] : kInvalidId;
+        h.geom = m_geom[h.geom];
+        return h;
+    }
+
+    Scene m_sub;                          ///< the objects probed (positions and indices only)
+
+private:
+    std::vector<uint32_t> m_geom;         ///< scene geometry id per m_sub geometry id
+    std::vector<uint32_t> m_inst;         ///< scene instance per m_sub instance
+    std::vector<uint8_t> m_candidate;     ///< per scene object (object_index)
+    std::unique_ptr<Accelerator> m_accel; ///< "bvh" over m_sub, with the derived filter
+};
+
+class DielectricContacts final : public ContactSearch {
 public:
     /// The surface of another medium found at a hit point, in the scene's ids.
     struct Contact {
@@ -98,25 +138,15 @@ public:
     /// Null when no two non-thin dielectrics of the scene can touch (nothing to look for).
     static std::shared_ptr<const DielectricContacts> find(const SceneView& view);
 
-    /// True when object `o` (object_index) may touch another non-thin dielectric.
-    bool candidate(uint32_t o) const { return m_candidate[o] != 0; }
-
     /// The front face of another non-thin dielectric within guaranteed_gap(p, scale) of p (scale:
     /// the surface hit's SurfacePoint::offset_scale, the unit secondary rays leave it by), found by
     /// a probe from just inside the surface hit along its outward unit normal. The reach is the
     /// float path's 12 units whatever the main accelerator: at least any RayOffsetPolicy's gap,
     /// so no surface a secondary ray may skip goes unlooked for.
     std::optional<Contact> at(const Vec3f& p, float scale, const Vec3f& outward) const {
-        const float reach = guaranteed_gap(p, scale);
         Contact c;
-        c.probe.org = p - outward * reach;
-        c.probe.dir = outward;
-        c.probe.tfar = 2.f * reach;
-        c.hit = m_accel->intersect(c.probe, RayKind::Refraction);
+        c.hit = probe_at(p, outward, guaranteed_gap(p, scale), c.probe);
         if (!c.hit.valid()) return std::nullopt;
-        const bool mesh = c.hit.geom < m_sub.meshes.size();
-        c.hit.inst = mesh ? m_inst[c.hit.inst] : kInvalidId;
-        c.hit.geom = m_geom[c.hit.geom];
         return c;
     }
 
@@ -139,15 +169,7 @@ public:
         }
         return false;
     }
-    Color transmittance(const Ray&, const Hit&) const override { return Color(0.f); }  // never asked
     uint32_t mesh_flags(uint32_t) const override { return kNeedsAccept; }
-
-private:
-    Scene m_sub;                          ///< the candidate objects (positions and indices only)
-    std::vector<uint32_t> m_geom;         ///< scene geometry id per m_sub geometry id
-    std::vector<uint32_t> m_inst;         ///< scene instance per m_sub instance
-    std::vector<uint8_t> m_candidate;     ///< per scene object (object_index): may touch another
-    std::unique_ptr<Accelerator> m_accel; ///< "bvh" over m_sub, with this filter
 };
 
 namespace {
@@ -168,10 +190,7 @@ struct ContactObject {
 /// contact the probe would find.
 double touch_tolerance(double m) { return 2.0 * double(kGuaranteedGapUlps) * std::max(m, 1e-30) * 0x1p-23; }
 
-double magnitude(const Bounds3d& b) {
-    return std::max({std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z), std::fabs(b.hi.x), std::fabs(b.hi.y),
-                     std::fabs(b.hi.z)});
-}
+double magnitude(const Bounds3d& b) { return std::max(max_abs(b.lo), max_abs(b.hi)); }
 
 /// Signed distances of a box's corners from a plane: [min, max].
 std::pair<double, double> plane_extent(const Plane& p, const Bounds3d& b) {
@@ -189,14 +208,13 @@ std::pair<double, double> plane_extent(const Plane& p, const Bounds3d& b) {
 /// (conservative) for meshes.
 bool may_touch(const ContactObject& a, const ContactObject& b) {
     if (a.kind == GeomKind::Plane && b.kind == GeomKind::Plane) {
-        const double tol = touch_tolerance(std::max(magnitude({a.plane->point, a.plane->point}),
-                                                    magnitude({b.plane->point, b.plane->point})));
+        const double tol = touch_tolerance(std::max(max_abs(a.plane->point), max_abs(b.plane->point)));
         return length(cross(a.plane->normal, b.plane->normal)) <= 1e-6 &&
                std::fabs(dot(a.plane->normal, b.plane->point - a.plane->point)) <= tol;
     }
     if (b.kind == GeomKind::Plane) return may_touch(b, a);
     if (a.kind == GeomKind::Plane) {
-        const double tol = touch_tolerance(std::max(magnitude(b.bounds), magnitude({a.plane->point, a.plane->point})));
+        const double tol = touch_tolerance(std::max(magnitude(b.bounds), max_abs(a.plane->point)));
         if (b.kind == GeomKind::Sphere)
             return std::fabs(std::fabs(dot(a.plane->normal, b.sphere->center - a.plane->point)) - b.sphere->radius) <= tol;
         const auto [lo, hi] = plane_extent(*a.plane, b.bounds);
@@ -292,6 +310,14 @@ void extract_objects(const Scene& scene, const std::vector<uint8_t>& keep, Scene
 
 }  // namespace
 
+void ContactSearch::build(const Scene& scene, std::vector<uint8_t> candidate, const std::vector<uint8_t>& keep) {
+    m_candidate = std::move(candidate);
+    // The kept objects as a scene of their own (geometry only), in scene order, in the in-house
+    // BVH: deterministic and watertight (docs/accelerators.md).
+    extract_objects(scene, keep, m_sub, m_geom, m_inst);
+    m_accel = create_accelerator("bvh", m_sub, *this);
+}
+
 std::shared_ptr<const DielectricContacts> DielectricContacts::find(const SceneView& view) {
     const Scene& scene = view.scene();
     const SceneAnalysis& analysis = view.analysis();
@@ -311,12 +337,9 @@ std::shared_ptr<const DielectricContacts> DielectricContacts::find(const SceneVi
             }
     if (!any) return nullptr;
 
-    // The candidates as a scene of their own (geometry only), in scene order.
+    // The candidates probe a structure over themselves.
     auto c = std::make_shared<DielectricContacts>();
-    c->m_candidate = std::move(candidate);
-    extract_objects(scene, c->m_candidate, c->m_sub, c->m_geom, c->m_inst);
-    // The in-house BVH: deterministic and watertight (docs/accelerators.md).
-    c->m_accel = create_accelerator("bvh", c->m_sub, *c);
+    c->build(scene, candidate, candidate);
     return c;
 }
 
@@ -339,13 +362,11 @@ std::shared_ptr<const DielectricContacts> DielectricContacts::find(const SceneVi
 // object; scenes without a pair build nothing, and the kernels test a null pointer. Non-thin
 // dielectrics on an opaque surface (their exit ray and absorption) remain open
 // (docs/numerical-stability.md).
-class OpaqueCovers final : public SurfaceFilter {
+class OpaqueCovers final : public ContactSearch {
 public:
-    /// Null when no thin transmissive object can touch an opaque one.
+    /// Null when no thin transmissive object can touch an opaque one. Candidates: the thin
+    /// transmissive objects that may touch an opaque object.
     static std::shared_ptr<const OpaqueCovers> find(const SceneView& view);
-
-    /// True when object `o` (object_index) is thin transmissive and may touch an opaque object.
-    bool candidate(uint32_t o) const { return m_candidate[o] != 0; }
 
     /// False when p is farther than the probe's reach from the bounds of every opaque object kept
     /// (most hits on a candidate: a panel standing on the floor touches it along one edge).
@@ -359,31 +380,16 @@ public:
     /// The opaque surface within guaranteed_gap(p, scale) of p on either side of the surface hit
     /// (unit normal n), in the scene's ids (t along the probe), or an invalid Hit.
     Hit at(const Vec3f& p, float scale, const Vec3f& n) const {
-        const float reach = guaranteed_gap(p, scale);
         Ray probe;
-        probe.org = p - n * reach;
-        probe.dir = n;
-        probe.tfar = 2.f * reach;
-        Hit h = m_accel->intersect(probe, RayKind::Refraction);
-        if (!h.valid()) return h;
-        const bool mesh = h.geom < m_sub.meshes.size();
-        h.inst = mesh ? m_inst[h.inst] : kInvalidId;
-        h.geom = m_geom[h.geom];
-        return h;
+        return probe_at(p, n, guaranteed_gap(p, scale), probe);
     }
 
     // SurfaceFilter: every face of an opaque object covers (masked and blended ones are not kept).
     bool accept(const Ray&, const Hit&, RayKind) const override { return true; }
-    Color transmittance(const Ray&, const Hit&) const override { return Color(0.f); }  // never asked
     uint32_t mesh_flags(uint32_t) const override { return 0; }
 
 private:
-    Scene m_sub;                          ///< the opaque objects that may touch (positions and indices only)
-    std::vector<uint32_t> m_geom;         ///< scene geometry id per m_sub geometry id
-    std::vector<uint32_t> m_inst;         ///< scene instance per m_sub instance
-    std::vector<uint8_t> m_candidate;     ///< per scene object (object_index): thin transmissive, may touch
-    Bounds3d m_bounds;                    ///< world bounds of the opaque objects kept (planes: infinite)
-    std::unique_ptr<Accelerator> m_accel; ///< "bvh" over m_sub, with this filter
+    Bounds3d m_bounds;  ///< world bounds of the opaque objects kept (planes: infinite)
 };
 
 std::shared_ptr<const OpaqueCovers> OpaqueCovers::find(const SceneView& view) {
@@ -410,10 +416,7 @@ std::shared_ptr<const OpaqueCovers> OpaqueCovers::find(const SceneView& view) {
                 any = true;
             }
     if (!any) return nullptr;
-
-    c->m_candidate = std::move(candidate);
-    extract_objects(scene, keep, c->m_sub, c->m_geom, c->m_inst);
-    c->m_accel = create_accelerator("bvh", c->m_sub, *c);
+    c->build(scene, std::move(candidate), keep);
     return c;
 }
 
@@ -439,14 +442,6 @@ template <KernelFeatures K>
 Color WhittedIntegrator::radiance_of(const Ray& ray, const Hit& hit, int depth, RayCounters& counters,
                                      PrimaryInfo* primary, const RayCone& cone, float weight) const {
     if (!hit.valid()) return m_settings.background;
-    if constexpr (K.transmission) {
-        // An opaque surface coinciding with a thin transmissive one is what the ray sees, whichever
-        // of the two the accelerator reported (OpaqueCovers).
-        if (m_covers && m_covers->candidate(object_index(m_view.scene(), hit.geom, hit.inst))) [[unlikely]] {
-            if (const std::optional<Hit> cover = opaque_cover(ray, hit, counters))
-                return sanitize(shade<K>(ray, *cover, depth, counters, primary, cone, weight));
-        }
-    }
     return sanitize(shade<K>(ray, hit, depth, counters, primary, cone, weight));
 }
 
@@ -518,8 +513,7 @@ std::optional<WhittedIntegrator::OtherMedium> WhittedIntegrator::other_medium(co
     return OtherMedium{mf.varying ? m_view.coefficients(so) : mf.constant, so.p, so.offset_scale};
 }
 
-std::optional<Hit> WhittedIntegrator::opaque_cover(const Ray& ray, const Hit& hit, RayCounters& counters) const {
-    const SurfacePoint sp = m_view.surface<false>(ray, hit);  // p, ng and offset_scale only
+std::optional<Hit> WhittedIntegrator::opaque_cover(const Hit& hit, const SurfacePoint& sp, RayCounters& counters) const {
     if (!m_covers->near(sp.p, sp.offset_scale)) return std::nullopt;
     ++counters.contact_probe;
     Hit cover = m_covers->at(sp.p, sp.offset_scale, sp.ng);
@@ -546,6 +540,14 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
         else if constexpr (!K.tables) return m_view.surface<true>(ray, hit, cone);
         else return mf.varying ? m_view.surface<true>(ray, hit, cone) : m_view.surface<false>(ray, hit, cone);
     }();
+    if constexpr (K.transmission) {
+        // An opaque surface coinciding with a thin transmissive one is what the ray sees, whichever
+        // of the two the accelerator reported (OpaqueCovers): shaded instead, as this ray's hit.
+        if (m_covers && m_covers->candidate(object_index(scene, hit.geom, hit.inst))) [[unlikely]] {
+            if (const std::optional<Hit> cover = opaque_cover(hit, sp, counters))
+                return shade<K>(ray, *cover, depth, counters, primary, cone, weight);
+        }
+    }
     WhittedCoeffs varying;
     const WhittedCoeffs& c = [&]() -> const WhittedCoeffs& {
         if constexpr (!K.tables) return varying = m_view.coefficients(sp);

@@ -162,9 +162,10 @@ private:
     };
     /// Looks for it at a hit on a non-thin dielectric (out of line, off the kernels' hot path).
     std::optional<OtherMedium> other_medium(const Hit& hit, const SurfacePoint& sp, RayCounters& counters) const;
-    /// The opaque surface coinciding with a hit on a thin transmissive object, as a hit of the same
-    /// ray at the same t (OpaqueCovers), or nullopt (out of line, off the kernels' hot path).
-    std::optional<Hit> opaque_cover(const Ray& ray, const Hit& hit, RayCounters& counters) const;
+    /// The opaque surface coinciding with a hit on a thin transmissive object (sp: its surface
+    /// point), as a hit of the same ray at the same t (OpaqueCovers), or nullopt (out of line, off
+    /// the kernels' hot path).
+    std::optional<Hit> opaque_cover(const Hit& hit, const SurfacePoint& sp, RayCounters& counters) const;
 
     const SceneView& m_view;
     const Accelerator& m_accel;

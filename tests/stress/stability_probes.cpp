@@ -18,8 +18,8 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "renderer/core/fp_mode.h"
 #include "renderer/accel/common/sphere.h"
+#include "renderer/core/fp_mode.h"
 #include "renderer/core/ray_offset.h"
 #include "renderer/integrator/camera.h"
 #include "renderer/integrator/scene_view.h"
@@ -30,7 +30,6 @@
 namespace whitted::stress {
 
 namespace {
-
 
 const Vec3d kTranslationDir{0.8, 0.36, -0.48};  // unit length, no component exactly representable
 
@@ -127,8 +126,6 @@ Vec3f wachter_binder_2019(const Vec3f& p, float, const Vec3f& n) {
     }
     return o;
 }
-
-float max_abs(const Vec3f& p) { return std::max(std::fabs(p.x), std::max(std::fabs(p.y), std::fabs(p.z))); }
 
 Mat4d placement(double scale, double translation, bool rotate) {
     Mat4d r;
@@ -273,7 +270,7 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
     Vec3d quad_normal{0, 0, 1};
     if (analytic) {
         for (double f : {1.0, 1.0 + d, 1.0 - d}) {
-            if (f <= 0.0) continue;  // see has_inner below
+            if (f <= 0.0) continue;  // no room for C: see has_inner above
             Sphere sp;
             sp.center = centre;
             sp.radius = s * f;
@@ -297,7 +294,7 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
         mesh.material = mat;
         scene.meshes.push_back(std::move(mesh));
         for (double f : {1.0, 1.0 + d, 1.0 - d})
-            if (f > 0.0) add_instance(scene, 0, placement(s * f, translation));  // see has_inner below
+            if (f > 0.0) add_instance(scene, 0, placement(s * f, translation));  // see has_inner above
     }
     Camera cam;
     scene.cameras.push_back(cam);
@@ -413,7 +410,7 @@ SelfIntersectionResult probe_self_intersection(const SelfIntersectionConfig& cfg
                 const Vec3d od = p_double + nd * (cfg.double_origin_ulps * u_offset);
                 for (int k = 0; k < 3; ++k) {
                     org[k] = float(od[k]);
-                    if ((double(org[k]) - od[k]) * nd[k] < 0.0) org[k] = std::nextafter(org[k], nd[k] > 0.0 ? kInfinity : -kInfinity);
+                    if ((double(org[k]) - od[k]) * nd[k] < 0.0) org[k] = detail::step_towards(org[k], float(nd[k]));
                 }
             }
             const double dist = surface_distance(Vec3d(org), hit) / u_offset * (inward ? -1.0 : 1.0);
@@ -806,7 +803,7 @@ namespace {
 class BoundTracer {
 public:
     BoundTracer(const SceneView& view, const Accelerator& accel, const IntegratorSettings& s)
-        : m_view(view), m_accel(accel), m_s(s) {}
+        : m_view(view), m_accel(accel), m_offset(accel.ray_offset()), m_s(s) {}
 
     Color trace(const Ray& ray, RayKind kind, int depth, const RayCone& cone, float weight) const {
         const Hit hit = m_accel.intersect(ray, kind);
@@ -830,7 +827,7 @@ public:
                 const float wt = weight * max_component(kt);
                 if (!is_black(kt) && wt >= m_s.min_weight) {
                     Ray t;
-                    t.org = m_accel.ray_offset().origin(sp.p, sp.offset_scale, -Ng);
+                    t.org = m_offset.origin(sp.p, sp.offset_scale, -Ng);
                     bool transmitted = true;
                     if (c.thin) {
                         t.dir = ray.dir;
@@ -847,7 +844,7 @@ public:
                     Vec3f R = reflect(V, N);
                     if (dot(R, Ng) <= 0.f) R = reflect(V, Ng);
                     Ray r;
-                    r.org = m_accel.ray_offset().origin(sp.p, sp.offset_scale, Ng);
+                    r.org = m_offset.origin(sp.p, sp.offset_scale, Ng);
                     r.dir = normalize(R);
                     result += kr * trace(r, RayKind::Reflection, depth + 1, secondary, wr);
                 }
@@ -859,7 +856,7 @@ public:
             const float alpha = std::clamp(m_view.material_inputs(mat, sp).base_color.w, 0.f, 1.f);
             if (alpha < 1.f) {
                 Ray behind;
-                behind.org = m_accel.ray_offset().origin(sp.p, sp.offset_scale, -Ng);
+                behind.org = m_offset.origin(sp.p, sp.offset_scale, -Ng);
                 behind.dir = ray.dir;
                 const Color b = depth < m_s.max_depth
                                     ? trace(behind, RayKind::Refraction, depth + 1, secondary, weight * (1.f - alpha))
@@ -873,6 +870,7 @@ public:
 private:
     const SceneView& m_view;
     const Accelerator& m_accel;
+    RayOffsetPolicy m_offset;  ///< m_accel's, as the integrator keeps it
     IntegratorSettings m_s;
 };
 

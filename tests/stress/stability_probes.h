@@ -21,8 +21,6 @@ namespace whitted::stress {
 
 /// Spacing of floats at |x| (ulp(0) = the smallest denormal).
 float ulp(float x);
-/// Largest absolute coordinate.
-float max_abs(const Vec3f& p);
 /// world_from_object = translate(t * kTranslationDir) * rotate(fixed, non-axis-aligned) * scale(s),
 /// composed in double. kTranslationDir has non-representable components (0.8, 0.36, -0.48).
 Mat4d placement(double scale, double translation, bool rotate = true);
