@@ -92,7 +92,7 @@ void run_self_intersection(const BenchStabilityOptions& o, Csv& csv) {
     struct Variant {
         ProbeSurface surface;
         bool smooth, previous, exact;
-        float offset_ulps = 0.f;  ///< offset_ray_origin at this distance instead of kOffsetUlps (0: the renderer's)
+        float offset_ulps = 0.f;  ///< with --offset-ulps: offset_ray_origin at this distance instead of the backend's policy
         bool point_unit = false;  ///< offsets in ulps of max|p| alone (ignoring offset_scale): the unit before
                                   ///< the hit primitive's coordinates were taken into account
     };
@@ -104,17 +104,18 @@ void run_self_intersection(const BenchStabilityOptions& o, Csv& csv) {
         {ProbeSurface::TiltedQuad, false, false, false, 0.f, true},
     };
     // --offset-ulps: the renderer's hit points with other offset distances (is a smaller one safe?).
-    if (!o.offset_ulps.empty()) {
+    const bool sweep = !o.offset_ulps.empty();
+    if (sweep) {
         variants.clear();
         for (const float u : o.offset_ulps)
             for (const ProbeSurface s : {ProbeSurface::MeshSphere, ProbeSurface::AnalyticSphere, ProbeSurface::TiltedQuad})
                 variants.push_back({s, false, false, false, u});
     }
-    auto offset_name = [&o](const Variant& v) {
+    auto offset_name = [&o, sweep](const Variant& v) {
         const std::string experiment = std::string(o.double_origin ? ", double origin" : "") + (o.skip_origin ? ", origin primitive skipped" : "");
         return (v.previous     ? std::string("previous (W&B 2019)")
                 : v.point_unit ? std::string("ulps of max\\|p\\| alone")
-                : !o.offset_ulps.empty() ? fmt::format("{:g} ulp", v.offset_ulps)
+                : sweep ? fmt::format("{:g} ulp", v.offset_ulps)
                                          : std::string("current")) + experiment;
     };
     // The backends without a per-primitive box test (brute, grid, octree) are the ones that found
@@ -142,18 +143,18 @@ void run_self_intersection(const BenchStabilityOptions& o, Csv& csv) {
                         c.points = o.points;
                         c.gap_ulps = gap;
                         if (v.previous) c.offset = wachter_binder_2019;
-                        if (v.offset_ulps > 0.f)
+                        if (sweep)
                             c.offset = [u = v.offset_ulps, f = o.scale_factor](const Vec3f& p, float scale, const Vec3f& n) {
                                 return offset_ray_origin(p, f * scale, n, u);
                             };
                         c.skip_origin = o.skip_origin;
-                        if (o.double_origin && !o.offset_ulps.empty()) c.double_origin_ulps = v.offset_ulps;
+                        if (o.double_origin && sweep) c.double_origin_ulps = v.offset_ulps;
                         if (v.point_unit)
                             c.offset = [](const Vec3f& p, float, const Vec3f& n) { return offset_ray_origin(p, 0.f, n); };
                         SelfIntersectionResult r = probe_self_intersection(c);
                         const std::string subject = surface_name(v.surface, v.smooth) + (v.previous ? " / previous offset" : "") +
                                                     (v.point_unit ? " / point-only unit" : "") +
-                                                    (v.offset_ulps > 0.f ? fmt::format(" / offset {:g} ulp", v.offset_ulps) : "") +
+                                                    (sweep ? fmt::format(" / offset {:g} ulp", v.offset_ulps) : "") +
                                                     (v.exact ? " / double hit point" : "") + fmt::format(" / gap {:g} ulp", gap);
                         const uint64_t n = r.rays[0] + r.rays[1] + r.rays[2];
                         const uint64_t sh = r.self_hits[0] + r.self_hits[1] + r.self_hits[2];
