@@ -9,7 +9,9 @@
 // "Standard" view, clamped to [0, 1]) and the fraction of pixels adaptive sampling subdivided.
 // It prints the targets (adaptive against stratified 16 spp, corners against center) with the
 // decomposition of adaptive's cost (camera rays, rays per camera ray, time per ray) and, with
-// --replay, how much of each target run is outside the ray trees. Writes <out>/aa.csv, per scene
+// --replay, how much of each target run is outside the ray trees. For the adaptive target it also
+// bisects the threshold between the sweep's octave steps (--target-search; those runs go to
+// <out>/aa_target_search.csv). Writes <out>/aa.csv, per scene
 // the reference image and an adaptive sample-density heat map, and (when python3 with matplotlib
 // is available) the error-against-time plots through scripts/plot_aa.py. See docs/antialiasing.md.
 #include <algorithm>
@@ -55,6 +57,7 @@ struct BenchAaOptions {
     bool quick = false;              ///< a shorter sweep
     std::vector<std::string> only;   ///< when given: run only the sweep settings whose label (as printed) is one of these
     bool replay = false;             ///< split the target runs' CPU time into ray trees and the rest (needs --threads 1)
+    int target_search = 3;           ///< bisection steps of the threshold search at the target (0 = the sweep's settings only)
     bool plot = true;                ///< run scripts/plot_aa.py afterwards when possible
     std::string python = "python3";  ///< interpreter with matplotlib for the plots
 };
@@ -231,6 +234,40 @@ ReplaySplit replay_split(const Renderer& renderer, const Scene& scene, const Ren
     return split;
 }
 
+/// The target's threshold search (`--target-search`): for each adaptive depth of the sweep, the
+/// largest threshold whose display RMSE is at most `target` and the next larger threshold of that
+/// depth, which misses it, are bisected `steps` times at their geometric mean; `render(t, d)`
+/// measures one setting. Returns the runs it measured, in order. A depth is skipped when none of
+/// its thresholds reaches the target or when its largest one already does (nothing to narrow).
+template <typename RenderFn>
+std::vector<Run> threshold_search(const std::vector<Run>& sweep_runs, double target, int steps, RenderFn&& render) {
+    std::vector<Run> out;
+    if (steps <= 0) return out;
+    std::vector<int> depths;
+    for (const Run& r : sweep_runs)
+        if (r.aa.mode == AaMode::Adaptive && std::find(depths.begin(), depths.end(), r.aa.depth) == depths.end())
+            depths.push_back(r.aa.depth);
+    for (const int d : depths) {
+        float pass = 0.f, fail = 0.f;  // thresholds; 0 = none
+        for (const Run& r : sweep_runs)
+            if (r.aa.mode == AaMode::Adaptive && r.aa.depth == d && r.rmse_disp <= target) pass = std::max(pass, r.aa.threshold);
+        if (!(pass > 0.f)) continue;
+        for (const Run& r : sweep_runs)
+            if (r.aa.mode == AaMode::Adaptive && r.aa.depth == d && r.aa.threshold > pass && r.rmse_disp > target &&
+                (fail == 0.f || r.aa.threshold < fail))
+                fail = r.aa.threshold;
+        if (!(fail > 0.f)) continue;
+        for (int k = 0; k < steps; ++k) {
+            // Three significant digits keep the labels readable; stop once they cannot split further.
+            const float t = std::stof(fmt::format("{:.3g}", std::sqrt(double(pass) * double(fail))));
+            if (!(t > pass && t < fail)) break;
+            out.push_back(render(t, d));
+            (out.back().rmse_disp <= target ? pass : fail) = t;
+        }
+    }
+    return out;
+}
+
 /// Marks the runs no other run beats in both time and display RMSE.
 void mark_pareto(std::vector<Run>& runs) {
     for (Run& r : runs) {
@@ -259,10 +296,15 @@ int run_bench_aa(const BenchAaOptions& o) {
     if (o.replay && o.threads != 1) throw Error("bench aa: --replay compares process CPU times and needs --threads 1");
     const DisplayTransform display(ColorSettings{});
 
-    std::ofstream csv(out / "aa.csv");
-    csv << "scene,mode,filter,threshold,depth,spp,label,seconds,camera_rays,total_rays,camera_rays_per_pixel,"
+    const std::string csv_header =
+        "scene,mode,filter,threshold,depth,spp,label,seconds,camera_rays,total_rays,camera_rays_per_pixel,"
            "rmse_linear,psnr_linear,relmse_linear,rmse_display,psnr_display,relmse_display,subdivided_fraction,"
            "pareto,timing,cpu_seconds,wall_seconds,shadow_rays,secondary_rays,threads,load\n";
+    std::ofstream csv(out / "aa.csv");
+    csv << csv_header;
+    // The threshold search's runs (the target), apart from the sweep the plots show.
+    std::ofstream search_csv(out / "aa_target_search.csv");
+    search_csv << csv_header;
 
     for (const std::string& scene_path : o.scenes) {
         const std::string label = scene_label(scene_path);
@@ -324,36 +366,39 @@ int run_bench_aa(const BenchAaOptions& o) {
             r.aa = aa;
             runs.push_back(std::move(r));
         }
-        for (int round = 0; round < std::max(1, o.repeat); ++round)
-            for (Run& r : runs) {
-                if (round > 0 && r.spent >= 2.0) continue;  // slow settings: fewer runs
-                RenderStats st;
-                const double cpu0 = process_cpu_seconds();
-                r.film = renderer.render(r.aa, &st);
-                const double cpu = process_cpu_seconds() - cpu0;
-                r.spent += cpu_time ? cpu : st.render_seconds;
-                r.cpu_seconds = std::min(r.cpu_seconds, cpu);
-                r.wall_seconds = std::min(r.wall_seconds, st.render_seconds);
-                r.stats = st;  // counts and image are the same every run
+        auto measure = [&](std::vector<Run>& batch) {
+            for (int round = 0; round < std::max(1, o.repeat); ++round)
+                for (Run& r : batch) {
+                    if (round > 0 && r.spent >= 2.0) continue;  // slow settings: fewer runs
+                    RenderStats st;
+                    const double cpu0 = process_cpu_seconds();
+                    r.film = renderer.render(r.aa, &st);
+                    const double cpu = process_cpu_seconds() - cpu0;
+                    r.spent += cpu_time ? cpu : st.render_seconds;
+                    r.cpu_seconds = std::min(r.cpu_seconds, cpu);
+                    r.wall_seconds = std::min(r.wall_seconds, st.render_seconds);
+                    r.stats = st;  // counts and image are the same every run
+                }
+            for (Run& r : batch) {
+                r.seconds = cpu_time ? r.cpu_seconds : r.wall_seconds;
+                const std::vector<float> img = packed(r.film);
+                r.film = Film{};
+                metrics(img, ref, r.rmse_lin, r.psnr_lin, r.relmse_lin);
+                metrics(to_display(img, display), ref_disp, r.rmse_disp, r.psnr_disp, r.relmse_disp);
             }
-        for (Run& r : runs) {
-            r.seconds = cpu_time ? r.cpu_seconds : r.wall_seconds;
-            const std::vector<float> img = packed(r.film);
-            r.film = Film{};
-            metrics(img, ref, r.rmse_lin, r.psnr_lin, r.relmse_lin);
-            metrics(to_display(img, display), ref_disp, r.rmse_disp, r.psnr_disp, r.relmse_disp);
-        }
+        };
+        measure(runs);
         mark_pareto(runs);
 
         std::printf("   %-28s %9s %10s %8s %10s %10s %8s %6s\n", "setting", "time[s]", "cam rays", "rays/px",
                     "rmse lin", "rmse disp", "psnr", "split");
         const double pixels = double(size.width) * double(size.height);
-        for (const Run& r : runs) {
+        auto report = [&](const Run& r, std::ofstream& to) {
             const double split = r.stats.pixels ? double(r.stats.pixels_subdivided) / double(r.stats.pixels) : 0.0;
             std::printf("   %-28s %9.4f %10llu %8.2f %10.5f %10.5f %8.2f %5.1f%%%s\n", describe(r.aa).c_str(), r.seconds,
                         (unsigned long long)r.stats.rays.camera, double(r.stats.rays.camera) / pixels, r.rmse_lin,
                         r.rmse_disp, r.psnr_disp, 100.0 * split, r.pareto ? "  *" : "");
-            csv << fmt::format("{},{},{},{:g},{},{},\"{}\",{:.6f},{},{},{:.4f},{:.6g},{:.4f},{:.6g},{:.6g},{:.4f},{:.6g},{:.5f},{},"
+            to << fmt::format("{},{},{},{:g},{},{},\"{}\",{:.6f},{},{},{:.4f},{:.6g},{:.4f},{:.6g},{:.6g},{:.4f},{:.6g},{:.5f},{},"
                                "{},{:.6f},{:.6f},{},{},{},{:.2f}\n",
                                label, aa_mode_name(r.aa.mode), pixel_filter_name(r.aa.filter),
                                r.aa.mode == AaMode::Adaptive ? r.aa.threshold : 0.f,
@@ -364,8 +409,9 @@ int run_bench_aa(const BenchAaOptions& o) {
                                r.psnr_disp, r.relmse_disp, split, r.pareto ? 1 : 0, o.timing, r.cpu_seconds,
                                r.wall_seconds, r.stats.rays.shadow, r.stats.rays.secondary(), r.stats.threads,
                                load_average_1min());
-        }
-        csv.flush();
+            to.flush();
+        };
+        for (const Run& r : runs) report(r, csv);
 
         // Targets (docs/antialiasing.md): adaptive against stratified 16 spp, corners against center.
         auto find = [&](AaMode mode, int spp) -> const Run* {
@@ -378,20 +424,40 @@ int run_bench_aa(const BenchAaOptions& o) {
         const Run* center = find(AaMode::Center, 1);
         const Run* corners = find(AaMode::Corners, 1);
         if (s16) {
+            // The sweep's thresholds are an octave apart, so its cheapest adaptive setting at the
+            // target can be much better than stratified 16 (and dearer than needed). Per depth,
+            // bisect the threshold between the largest one that reaches stratified 16's display
+            // RMSE and the next larger one that does not (geometric means; only measured runs
+            // count, so a non-monotone step just narrows the wrong way).
+            if (o.target_search > 0) std::printf("   threshold search at stratified 16's display RMSE %.5f:\n", s16->rmse_disp);
+            const std::vector<Run> searched = threshold_search(runs, s16->rmse_disp, o.target_search, [&](float t, int d) {
+                std::vector<Run> one(1);
+                one[0].scene = label;
+                one[0].aa.mode = AaMode::Adaptive;
+                one[0].aa.threshold = t;
+                one[0].aa.depth = d;
+                measure(one);
+                report(one[0], search_csv);
+                return one[0];
+            });
+            std::vector<const Run*> candidates;
+            for (const Run& r : runs) candidates.push_back(&r);
+            for (const Run& r : searched) candidates.push_back(&r);
             const Run* best = nullptr;
-            for (const Run& r : runs)
-                if (r.aa.mode == AaMode::Adaptive && r.rmse_disp <= s16->rmse_disp && (!best || r.seconds < best->seconds)) best = &r;
+            for (const Run* r : candidates)
+                if (r->aa.mode == AaMode::Adaptive && r->rmse_disp <= s16->rmse_disp && (!best || r->seconds < best->seconds)) best = r;
             // Also by total rays traced: a cost that does not depend on the machine's load.
             const Run* fewest = nullptr;
-            for (const Run& r : runs)
-                if (r.aa.mode == AaMode::Adaptive && r.rmse_disp <= s16->rmse_disp &&
-                    (!fewest || r.stats.rays.total() < fewest->stats.rays.total()))
-                    fewest = &r;
+            for (const Run* r : candidates)
+                if (r->aa.mode == AaMode::Adaptive && r->rmse_disp <= s16->rmse_disp &&
+                    (!fewest || r->stats.rays.total() < fewest->stats.rays.total()))
+                    fewest = r;
             auto rays_ratio = [&](const Run& r) { return double(r.stats.rays.total()) / double(s16->stats.rays.total()); };
             if (best) {
-                std::printf("   target adaptive <= 1/3 time of stratified 16 at its display RMSE %.5f: %s at %.3fx time "
+                std::printf("   target adaptive <= 1/3 time of stratified 16 at its display RMSE %.5f%s: %s at %.3fx time "
                             "(%.3fx total rays) -> %s; fewest rays: %s at %.3fx\n",
-                            s16->rmse_disp, describe(best->aa).c_str(), best->seconds / s16->seconds, rays_ratio(*best),
+                            s16->rmse_disp, searched.empty() ? "" : " (threshold search)", describe(best->aa).c_str(),
+                            best->seconds / s16->seconds, rays_ratio(*best),
                             best->seconds <= s16->seconds / 3.0 ? "MET" : "NOT MET", describe(fewest->aa).c_str(),
                             rays_ratio(*fewest));
                 // Why time and rays differ: rays per camera ray (the ray trees' size) and time per ray.
@@ -432,7 +498,7 @@ int run_bench_aa(const BenchAaOptions& o) {
         Film center_film = renderer.render(AaSettings{});
         write_image(center_film, (out / (label + "-center.png")).string(), OutputSettings{});
     }
-    std::printf("wrote %s\n", (out / "aa.csv").c_str());
+    std::printf("wrote %s, %s\n", (out / "aa.csv").c_str(), (out / "aa_target_search.csv").c_str());
 
     if (o.plot) {
         const fs::path script = fs::path(WHITTED_SOURCE_DIR) / "scripts" / "plot_aa.py";
@@ -472,6 +538,10 @@ Command register_bench_aa(CLI::App& bench) {
         ->allow_extra_args(false);
     app->add_flag("--replay", o->replay, "For the target runs, time the render against replaying its camera rays "
                   "through the integrator in a plain loop (needs --threads 1)");
+    app->add_option("--target-search", o->target_search, "Bisection steps of the adaptive threshold between the "
+                    "sweep's settings around stratified 16's RMSE, per depth (0 = the sweep's settings only); "
+                    "runs in <out>/aa_target_search.csv")
+        ->check(CLI::Range(0, 10))->capture_default_str();
     app->add_flag("!--no-plot", o->plot, "Do not run scripts/plot_aa.py");
     app->add_option("--python", o->python, "Python interpreter with matplotlib for the plots")->capture_default_str();
     return Command{app, [o] { return run_bench_aa(*o); }};

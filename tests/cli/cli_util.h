@@ -7,8 +7,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace whitted::test {
 
@@ -42,6 +44,34 @@ inline Result run(const std::string& args) {
     r.out = slurp(out);
     r.err = slurp(err);
     return r;
+}
+
+/// A CSV without quoted commas as rows of column -> value (the benches write none). A row with the
+/// wrong number of fields also gets "_bad" = the line.
+inline std::vector<std::map<std::string, std::string>> read_csv(const std::filesystem::path& path,
+                                                                std::vector<std::string>* header = nullptr) {
+    std::istringstream in(slurp(path));
+    std::string line;
+    std::vector<std::string> columns;
+    std::vector<std::map<std::string, std::string>> rows;
+    auto split = [](const std::string& l) {
+        std::vector<std::string> f;
+        std::stringstream ss(l);
+        std::string cell;
+        while (std::getline(ss, cell, ',')) f.push_back(cell);
+        return f;
+    };
+    if (!std::getline(in, line)) return rows;
+    columns = split(line);
+    if (header) *header = columns;
+    while (std::getline(in, line)) {
+        const std::vector<std::string> f = split(line);
+        std::map<std::string, std::string> row;
+        for (size_t i = 0; i < columns.size() && i < f.size(); ++i) row[columns[i]] = f[i];
+        if (f.size() != columns.size()) row["_bad"] = line;
+        rows.push_back(row);
+    }
+    return rows;
 }
 
 }  // namespace whitted::test

@@ -19,6 +19,7 @@
 namespace {
 
 namespace fs = std::filesystem;
+using whitted::test::read_csv;
 using whitted::test::Result;
 using whitted::test::run;
 using whitted::test::slurp;
@@ -30,32 +31,6 @@ fs::path temp_dir(const std::string& name) {
 }
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
-/// A CSV without quoted fields as rows of column -> value (the bench writes none with commas).
-std::vector<std::map<std::string, std::string>> read_csv(const fs::path& path, std::vector<std::string>* header = nullptr) {
-    std::istringstream in(slurp(path));
-    std::string line;
-    std::vector<std::string> columns;
-    std::vector<std::map<std::string, std::string>> rows;
-    auto split = [](const std::string& l) {
-        std::vector<std::string> f;
-        std::stringstream ss(l);
-        std::string cell;
-        while (std::getline(ss, cell, ',')) f.push_back(cell);
-        return f;
-    };
-    if (!std::getline(in, line)) return rows;
-    columns = split(line);
-    if (header) *header = columns;
-    while (std::getline(in, line)) {
-        const std::vector<std::string> f = split(line);
-        std::map<std::string, std::string> row;
-        for (size_t i = 0; i < columns.size() && i < f.size(); ++i) row[columns[i]] = f[i];
-        if (f.size() != columns.size()) row["_bad"] = line;  // a row with the wrong number of fields
-        rows.push_back(row);
-    }
-    return rows;
-}
 
 const std::string kWhitted1980 = std::string(WHITTED_ASSETS_DIR) + "/scenes/whitted1980.json";
 
