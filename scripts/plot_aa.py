@@ -9,7 +9,8 @@ sweep; stratified: one per filter along spp), the Pareto front (no other run is 
 and more accurate) as a dashed black line through circled points, and a star at 1/3 of stratified
 16 spp's cost at its error (the adaptive target: a curve below and left of it meets it). A
 second panel plots the same error against total rays traced, a cost that does not depend on the
-machine's load.
+machine's load. When `aa_target_search.csv` (the bench's `--target-search` runs) lies next to
+AA.CSV, its runs are drawn as crosses in their depth's colour.
 Needs matplotlib (Debian: apt-get install python3-matplotlib).
 """
 import csv
@@ -40,6 +41,11 @@ def main():
     scenes = defaultdict(list)
     for r in rows:
         scenes[r["scene"]].append(r)
+    searched = defaultdict(list)
+    search_path = os.path.join(os.path.dirname(path), "aa_target_search.csv")
+    if os.path.exists(search_path):
+        for r in csv.DictReader(open(search_path, newline="")):
+            searched[r["scene"]].append(r)
     styles = {"center": ("s", "tab:gray"), "corners": ("D", "tab:brown"), "adaptive d=1": ("o", "tab:olive"),
               "adaptive d=2": ("o", "tab:orange"), "adaptive d=3": ("o", "tab:red"),
               "stratified box": ("^", "tab:blue"), "stratified tent": ("v", "tab:cyan")}
@@ -59,6 +65,14 @@ def main():
                 marker, color = styles.get(name, ("x", "black"))
                 ax.plot([float(p[xkey]) for p in pts], [float(p["rmse_display"]) for p in pts], marker=marker,
                         color=color, label=name, linewidth=1.2, markersize=5)
+            # The threshold search's runs (not in the Pareto front, which is the sweep's).
+            by_depth = defaultdict(list)
+            for r in searched.get(scene, []):
+                by_depth[curve_key(r)].append(r)
+            for name, pts in sorted(by_depth.items()):
+                ax.scatter([float(p[xkey]) for p in pts], [float(p["rmse_display"]) for p in pts], marker="x",
+                           color=styles.get(name, ("x", "black"))[1], s=30, linewidths=1.0,
+                           label=f"threshold search, {name.split()[-1]}")
             # Pareto front over this axis' cost.
             ordered = sorted(runs, key=lambda r: (float(r[xkey]), float(r["rmse_display"])))
             front, best = [], float("inf")

@@ -42,7 +42,7 @@ namespace {
 namespace fs = std::filesystem;
 
 /// Bumped whenever a renderer change invalidates cached references.
-constexpr const char* kReferenceVersion = "aa-reference-v2";  // v2: ray offsets in units of the hit primitive
+constexpr const char* kReferenceVersion = "aa-reference-v3";  // v2: ray offsets in units of the hit primitive; v3: opaque covers (default.glb)
 
 struct BenchAaOptions {
     std::vector<std::string> scenes;
@@ -201,6 +201,31 @@ std::vector<AaSettings> sweep(bool quick) {
     return s;
 }
 
+/// The settings to run: the sweep, or with --only the labelled ones. An adaptive label outside the
+/// sweep ('adaptive t=0.0595 d=2', as the threshold search prints them) adds that setting, so a
+/// searched setting can be timed again; any other unknown label is an error (a misspelt one would
+/// silently run nothing).
+std::vector<AaSettings> selected_settings(bool quick, const std::vector<std::string>& only) {
+    const std::vector<AaSettings> all = sweep(quick);
+    if (only.empty()) return all;
+    std::vector<AaSettings> out;
+    for (const AaSettings& aa : all)
+        if (std::find(only.begin(), only.end(), describe(aa)) != only.end()) out.push_back(aa);
+    for (const std::string& label : only) {
+        if (std::any_of(all.begin(), all.end(), [&](const AaSettings& aa) { return describe(aa) == label; })) continue;
+        AaSettings aa;
+        aa.mode = AaMode::Adaptive;
+        char tail = 0;
+        const bool parsed = std::sscanf(label.c_str(), "adaptive t=%f d=%d%c", &aa.threshold, &aa.depth, &tail) == 2;
+        if (!parsed || aa.depth < 0 || aa.depth > 8 || describe(aa) != label)
+            throw Error(fmt::format("--only '{}': no such setting in the sweep, nor an adaptive setting 'adaptive t=T d=D' "
+                                    "with D in 0..8 (labels as printed, e.g. 'adaptive t=0.05 d=2', 'stratified 16 spp box')",
+                                    label));
+        if (std::none_of(out.begin(), out.end(), [&](const AaSettings& o) { return describe(o) == label; })) out.push_back(aa);
+    }
+    return out;
+}
+
 /// Where a render's CPU time goes: the time of the render (min of `repeat`) and of tracing the same
 /// camera rays, recorded from it, through the integrator in a plain loop on this thread (the ray
 /// trees alone). The difference is what the sampling mode adds: camera ray generation, the AA
@@ -287,12 +312,7 @@ int run_bench_aa(const BenchAaOptions& o) {
     fs::create_directories(cache);
     if (o.timing != "cpu" && o.timing != "wall") throw Error(fmt::format("--timing: expected cpu or wall, got '{}'", o.timing));
     const bool cpu_time = o.timing == "cpu";
-    for (const std::string& label : o.only) {  // a misspelt label would silently run nothing
-        const std::vector<AaSettings> all = sweep(o.quick);
-        if (std::none_of(all.begin(), all.end(), [&](const AaSettings& aa) { return describe(aa) == label; }))
-            throw Error(fmt::format("--only '{}': no such setting in the sweep (labels as printed, e.g. 'adaptive t=0.05 "
-                                    "d=2', 'stratified 16 spp box')", label));
-    }
+    const std::vector<AaSettings> settings = selected_settings(o.quick, o.only);
     if (o.replay && o.threads != 1) throw Error("bench aa: --replay compares process CPU times and needs --threads 1");
     const DisplayTransform display(ColorSettings{});
 
@@ -359,8 +379,7 @@ int run_bench_aa(const BenchAaOptions& o) {
         // Every setting once per round, --repeat rounds: each keeps its minimum time, and a burst of
         // load on a shared machine spreads over the settings instead of hitting one.
         std::vector<Run> runs;
-        for (const AaSettings& aa : sweep(o.quick)) {
-            if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), describe(aa)) == o.only.end()) continue;
+        for (const AaSettings& aa : settings) {
             Run r;
             r.scene = label;
             r.aa = aa;

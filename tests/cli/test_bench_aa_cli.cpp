@@ -8,6 +8,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -120,6 +121,33 @@ TEST(BenchAaCli, NoSearchWithZeroSteps) {
     EXPECT_TRUE(read_csv(out / "aa_target_search.csv").empty());
     EXPECT_EQ(r.out.find("(threshold search)"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("target adaptive <= 1/3 time of stratified 16"), std::string::npos) << r.out;
+}
+
+}  // namespace
+
+namespace {
+
+// --only runs the labelled settings; an adaptive label outside the sweep (as the search prints
+// them) is run too, and anything else is one error line and a non-zero exit.
+TEST(BenchAaCli, OnlyRunsTheLabelledSettingsIncludingSearchedThresholds) {
+    const fs::path out = temp_dir("only");
+    const std::string common = "bench aa '" + kBox + "' --width 32 --ref-spp 4 --repeat 1 --threads 1 --no-plot --out '" +
+                               out.string() + "' --cache '" + (out / "cache").string() + "' ";
+    const Result r = run(common + "--only 'adaptive t=0.0595 d=2' --only 'stratified 16 spp box'");
+    ASSERT_EQ(r.code, 0) << r.out << r.err;
+    const std::vector<Row> rows = read_csv(out / "aa.csv");
+    ASSERT_EQ(rows.size(), 2u);
+    EXPECT_EQ(rows[0].at("label"), "\"stratified 16 spp box\"");
+    EXPECT_EQ(rows[1].at("label"), "\"adaptive t=0.0595 d=2\"");
+    EXPECT_FLOAT_EQ(float(num(rows[1], "threshold")), 0.0595f);
+    EXPECT_EQ(rows[1].at("depth"), "2");
+
+    for (const char* bad : {"adaptive t=0.05 d=9", "stratified 17 spp box", "adaptive t=0.05 d=2 "}) {
+        const Result e = run(common + "--only '" + bad + "'");
+        EXPECT_NE(e.code, 0) << bad;
+        EXPECT_NE(e.err.find(std::string("--only '") + bad + "': no such setting"), std::string::npos) << e.err;
+        EXPECT_LE(std::count(e.err.begin(), e.err.end(), '\n'), 1) << e.err;
+    }
 }
 
 }  // namespace
