@@ -55,7 +55,7 @@ struct BenchAaOptions {
     std::string out = "bench-aa";    ///< output directory (CSV, images, plots)
     std::string cache;               ///< reference cache directory; empty = $XDG_CACHE_HOME/whitted or ~/.cache/whitted
     bool quick = false;              ///< a shorter sweep
-    std::vector<std::string> only;   ///< when given: run only the sweep settings whose label (as printed) is one of these
+    std::vector<std::string> only;   ///< when given: run only the settings with these labels (as printed; adaptive ones may lie outside the sweep)
     bool replay = false;             ///< split the target runs' CPU time into ray trees and the rest (needs --threads 1)
     int target_search = 3;           ///< bisection steps of the threshold search at the target (0 = the sweep's settings only)
     bool plot = true;                ///< run scripts/plot_aa.py afterwards when possible
@@ -418,16 +418,16 @@ int run_bench_aa(const BenchAaOptions& o) {
                         (unsigned long long)r.stats.rays.camera, double(r.stats.rays.camera) / pixels, r.rmse_lin,
                         r.rmse_disp, r.psnr_disp, 100.0 * split, r.pareto ? "  *" : "");
             to << fmt::format("{},{},{},{:g},{},{},\"{}\",{:.6f},{},{},{:.4f},{:.6g},{:.4f},{:.6g},{:.6g},{:.4f},{:.6g},{:.5f},{},"
-                               "{},{:.6f},{:.6f},{},{},{},{:.2f}\n",
-                               label, aa_mode_name(r.aa.mode), pixel_filter_name(r.aa.filter),
-                               r.aa.mode == AaMode::Adaptive ? r.aa.threshold : 0.f,
-                               r.aa.mode == AaMode::Adaptive ? r.aa.depth : 0,
-                               r.aa.mode == AaMode::Stratified ? r.aa.spp : (r.aa.mode == AaMode::Center ? 1 : 0),
-                               describe(r.aa), r.seconds, r.stats.rays.camera, r.stats.rays.total(),
-                               double(r.stats.rays.camera) / pixels, r.rmse_lin, r.psnr_lin, r.relmse_lin, r.rmse_disp,
-                               r.psnr_disp, r.relmse_disp, split, r.pareto ? 1 : 0, o.timing, r.cpu_seconds,
-                               r.wall_seconds, r.stats.rays.shadow, r.stats.rays.secondary(), r.stats.threads,
-                               load_average_1min());
+                              "{},{:.6f},{:.6f},{},{},{},{:.2f}\n",
+                              label, aa_mode_name(r.aa.mode), pixel_filter_name(r.aa.filter),
+                              r.aa.mode == AaMode::Adaptive ? r.aa.threshold : 0.f,
+                              r.aa.mode == AaMode::Adaptive ? r.aa.depth : 0,
+                              r.aa.mode == AaMode::Stratified ? r.aa.spp : (r.aa.mode == AaMode::Center ? 1 : 0),
+                              describe(r.aa), r.seconds, r.stats.rays.camera, r.stats.rays.total(),
+                              double(r.stats.rays.camera) / pixels, r.rmse_lin, r.psnr_lin, r.relmse_lin, r.rmse_disp,
+                              r.psnr_disp, r.relmse_disp, split, r.pareto ? 1 : 0, o.timing, r.cpu_seconds,
+                              r.wall_seconds, r.stats.rays.shadow, r.stats.rays.secondary(), r.stats.threads,
+                              load_average_1min());
             to.flush();
         };
         for (const Run& r : runs) report(r, csv);
