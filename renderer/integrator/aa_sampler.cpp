@@ -1,9 +1,9 @@
 #include "renderer/integrator/aa_sampler.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 
 #include "renderer/core/error.h"
 
@@ -87,11 +87,7 @@ constexpr float kSlopeBelow[11] = {0.439144f, 0.439144f, 0.657972f, 0.985844f, 1
 constexpr float kSlack = 1e-5f;
 
 /// Biased binary exponent of a non-negative float (0 for 0).
-int biased_exponent(float v) {
-    uint32_t bits;
-    std::memcpy(&bits, &v, sizeof bits);
-    return int(bits >> 23);
-}
+int biased_exponent(float v) { return int(std::bit_cast<uint32_t>(v) >> 23); }
 
 }  // namespace
 

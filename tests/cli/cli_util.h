@@ -46,6 +46,17 @@ inline Result run(const std::string& args) {
     return r;
 }
 
+/// A folder for one test's files, created if needed: <tmp>/<prefix>_<pid>/<name> (per process, so
+/// parallel ctest runs do not share it).
+inline std::filesystem::path scratch_dir(const std::string& prefix, const std::string& name) {
+    std::string folder = prefix;  // appended, not `prefix + "_" + ...` (GCC 12's -Wrestrict false positive)
+    folder += '_';
+    folder += std::to_string(::getpid());
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / folder / name;
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
 /// A CSV without quoted commas as rows of column -> value (the benches write none). A row with the
 /// wrong number of fields also gets "_bad" = the line.
 inline std::vector<std::map<std::string, std::string>> read_csv(const std::filesystem::path& path,

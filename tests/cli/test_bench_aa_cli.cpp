@@ -6,8 +6,6 @@
 
 #include "cli_util.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -25,11 +23,7 @@ using whitted::test::run;
 
 using Row = std::map<std::string, std::string>;
 
-fs::path temp_dir(const std::string& name) {
-    const fs::path dir = fs::temp_directory_path() / ("whitted_bench_aa_cli_" + std::to_string(::getpid())) / name;
-    fs::create_directories(dir);
-    return dir;
-}
+fs::path temp_dir(const std::string& name) { return whitted::test::scratch_dir("whitted_bench_aa_cli", name); }
 
 const std::string kBox = std::string(WHITTED_ASSETS_DIR) + "/gltf/Box/glTF-Binary/Box.glb";
 

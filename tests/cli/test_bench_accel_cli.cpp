@@ -8,8 +8,6 @@
 
 #include "cli_util.h"
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <map>
 #include <sstream>
@@ -24,11 +22,7 @@ using whitted::test::Result;
 using whitted::test::run;
 using whitted::test::slurp;
 
-fs::path temp_dir(const std::string& name) {
-    const fs::path dir = fs::temp_directory_path() / ("whitted_bench_accel_cli_" + std::to_string(::getpid())) / name;
-    fs::create_directories(dir);
-    return dir;
-}
+fs::path temp_dir(const std::string& name) { return whitted::test::scratch_dir("whitted_bench_accel_cli", name); }
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
