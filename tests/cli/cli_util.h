@@ -57,8 +57,9 @@ inline std::filesystem::path scratch_dir(const std::string& prefix, const std::s
     return dir;
 }
 
-/// A CSV without quoted commas as rows of column -> value (the benches write none). A row with the
-/// wrong number of fields also gets "_bad" = the line.
+/// A CSV as rows of column -> value. Fields may be double-quoted (bench skip quotes its kernel
+/// names, which hold commas; "" inside quotes is a quote). A row with the wrong number of fields
+/// also gets "_bad" = the line.
 inline std::vector<std::map<std::string, std::string>> read_csv(const std::filesystem::path& path,
                                                                 std::vector<std::string>* header = nullptr) {
     std::istringstream in(slurp(path));
@@ -66,10 +67,15 @@ inline std::vector<std::map<std::string, std::string>> read_csv(const std::files
     std::vector<std::string> columns;
     std::vector<std::map<std::string, std::string>> rows;
     auto split = [](const std::string& l) {
-        std::vector<std::string> f;
-        std::stringstream ss(l);
-        std::string cell;
-        while (std::getline(ss, cell, ',')) f.push_back(cell);
+        std::vector<std::string> f(1);
+        bool quoted = false;
+        for (size_t i = 0; i < l.size(); ++i) {
+            const char ch = l[i];
+            if (quoted && ch == '"' && i + 1 < l.size() && l[i + 1] == '"') f.back() += l[++i];
+            else if (ch == '"') quoted = !quoted;
+            else if (ch == ',' && !quoted) f.emplace_back();
+            else f.back() += ch;
+        }
         return f;
     };
     if (!std::getline(in, line)) return rows;

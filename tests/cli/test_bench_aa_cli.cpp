@@ -60,7 +60,7 @@ TEST(BenchAaCli, SweepCountsAndABisectingThresholdSearch) {
         } else if (row.at("mode") == "stratified") {
             EXPECT_EQ(cam, std::stol(row.at("spp")) * 64 * 48);
         }
-        if (row.at("label") == "\"stratified 16 spp box\"") s16 = &row;
+        if (row.at("label") == "stratified 16 spp box") s16 = &row;
     }
     ASSERT_NE(s16, nullptr);
     const double target = num(*s16, "rmse_display");
@@ -103,7 +103,7 @@ TEST(BenchAaCli, SweepCountsAndABisectingThresholdSearch) {
     const Row* best = nullptr;
     for (const std::vector<Row>* rows : {&sweep, &searched})
         for (const Row& row : *rows)
-            if (row.at("label") == "\"" + label + "\"") best = &row;
+            if (row.at("label") == label) best = &row;
     ASSERT_NE(best, nullptr) << label;
     EXPECT_LE(num(*best, "rmse_display"), target) << label;
 }
@@ -131,8 +131,8 @@ TEST(BenchAaCli, OnlyRunsTheLabelledSettingsIncludingSearchedThresholds) {
     ASSERT_EQ(r.code, 0) << r.out << r.err;
     const std::vector<Row> rows = read_csv(out / "aa.csv");
     ASSERT_EQ(rows.size(), 2u);
-    EXPECT_EQ(rows[0].at("label"), "\"stratified 16 spp box\"");
-    EXPECT_EQ(rows[1].at("label"), "\"adaptive t=0.0595 d=2\"");
+    EXPECT_EQ(rows[0].at("label"), "stratified 16 spp box");
+    EXPECT_EQ(rows[1].at("label"), "adaptive t=0.0595 d=2");
     EXPECT_FLOAT_EQ(float(num(rows[1], "threshold")), 0.0595f);
     EXPECT_EQ(rows[1].at("depth"), "2");
 

@@ -1,5 +1,6 @@
-// `whitted render --no-specialize`, the analysis in `whitted info` and in the render log, end to
-// end through the executable (the way tests/cli/test_cli.cpp runs it).
+// `whitted render --no-specialize`, the analysis in `whitted info` and in the render log, and
+// `whitted bench skip`'s claims (not its timings), end to end through the executable (the way
+// tests/cli/test_cli.cpp runs it).
 #include <gtest/gtest.h>
 
 #include "cli_image.h"
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -18,6 +20,7 @@
 namespace {
 
 namespace fs = std::filesystem;
+using whitted::test::read_csv;
 using whitted::test::read_pixels;
 using whitted::test::Result;
 using whitted::test::run;
@@ -65,6 +68,64 @@ TEST(SkipCli, InfoPrintsTheAnalysis) {
     EXPECT_TRUE(contains(r.out, "\nanalysis: opaque=no recursive=yes")) << r.out;
     EXPECT_TRUE(contains(r.out, "\nanalysis memory: triangles=")) << r.out;
     EXPECT_TRUE(contains(r.out, "\nanalysis material[0]: used=yes")) << r.out;
+}
+
+// bench skip on a small render: the specialised kernel's image equals the general one at
+// min_weight 0 (whole render and camera pass), the min-weight sweep only removes secondary rays,
+// and the Whitted overhead replays exactly the rays the render counted.
+TEST(SkipCli, BenchSkipReplaysTheRaysTheRenderCounted) {
+    const fs::path out = temp_dir() / "bench";
+    const Result r = run("bench skip '" + kScene + "' --width 96 --repeat 2 --threads 1 --no-plot --no-packets -o '" +
+                         out.string() + "'");
+    ASSERT_EQ(r.code, 0) << r.out << r.err;
+    EXPECT_TRUE(contains(r.out, "(median of 2 render/replay pairs;")) << r.out;
+
+    auto num = [](const std::map<std::string, std::string>& row, const char* column) { return std::stod(row.at(column)); };
+    const auto rows = read_csv(out / "skip.csv");
+    ASSERT_EQ(rows.size(), 2u + 6u);  // general and specialised, then the default sweep without its 0
+    std::map<std::string, std::string> at_default;
+    double last_min_weight = 0.0, last_secondary = 1e300;
+    for (size_t i = 0; i < rows.size(); ++i) {
+        const auto& row = rows[i];
+        ASSERT_EQ(row.count("_bad"), 0u) << row.at("_bad");
+        EXPECT_EQ(num(row, "total"), num(row, "camera") + num(row, "shadow") + num(row, "secondary"));
+        EXPECT_EQ(num(row, "secondary"), num(row, "reflection") + num(row, "refraction"));
+        if (i < 2) {
+            // The specialisation skips only work that contributes 0: the same image, the same rays.
+            EXPECT_EQ(row.at("variant"), i == 0 ? "general" : "specialised");
+            EXPECT_EQ(num(row, "differing_pixels"), 0.0) << row.at("variant");
+            EXPECT_EQ(num(row, "total"), num(rows[0], "total"));
+            continue;
+        }
+        // A larger cutoff traces a subset of the rays a smaller one traces.
+        EXPECT_GT(num(row, "min_weight"), last_min_weight);
+        EXPECT_LE(num(row, "secondary"), last_secondary) << row.at("min_weight");
+        EXPECT_EQ(num(row, "camera"), num(rows[0], "camera"));
+        last_min_weight = num(row, "min_weight");
+        last_secondary = num(row, "secondary");
+        if (row.at("min_weight") == "0.00392157") at_default = row;
+    }
+    EXPECT_LT(last_secondary, num(rows[0], "secondary"));  // whitted1980 has mirrors and glass
+    ASSERT_FALSE(at_default.empty());
+
+    // The overhead's recorded rays are the rays a render at the CLI default min_weight counts.
+    const auto overhead = read_csv(out / "skip_overhead.csv");
+    ASSERT_EQ(overhead.size(), 1u);
+    const auto& o = overhead[0];
+    ASSERT_EQ(o.count("_bad"), 0u) << o.at("_bad");
+    for (const char* kind : {"camera", "shadow", "secondary"}) EXPECT_EQ(num(o, kind), num(at_default, kind)) << kind;
+    EXPECT_EQ(num(o, "rays"), num(at_default, "total"));
+    EXPECT_NEAR(num(o, "render_mrays"), num(o, "rays") / num(o, "render_s") * 1e-6, 0.01 * num(o, "render_mrays"));
+    EXPECT_NEAR(num(o, "replay_mrays"), num(o, "rays") / num(o, "replay_s") * 1e-6, 0.01 * num(o, "replay_mrays"));
+    EXPECT_GT(num(o, "overhead_ratio"), 0.0);
+
+    // The camera pass: ray by ray and in packets, the specialised kernel gives the general image.
+    const auto pass = read_csv(out / "skip_camera_pass.csv");
+    ASSERT_GE(pass.size(), 3u);
+    for (const auto& row : pass) {
+        ASSERT_EQ(row.count("_bad"), 0u) << row.at("_bad");
+        EXPECT_EQ(num(row, "differing_pixels"), 0.0) << row.at("variant");
+    }
 }
 
 }  // namespace
