@@ -368,20 +368,17 @@ public:
     /// transmissive objects that may touch an opaque object.
     static std::shared_ptr<const OpaqueCovers> find(const SceneView& view);
 
-    /// False when p is farther than the probe's reach from the bounds of every opaque object kept
-    /// (most hits on a candidate: a panel standing on the floor touches it along one edge).
-    bool near(const Vec3f& p, float scale) const {
-        const double reach = guaranteed_gap(p, scale);
-        for (int k = 0; k < 3; ++k)
-            if (double(p[k]) < m_bounds.lo[k] - reach || double(p[k]) > m_bounds.hi[k] + reach) return false;
-        return true;
-    }
-
     /// The opaque surface within guaranteed_gap(p, scale) of p on either side of the surface hit
-    /// (unit normal n), in the scene's ids (t along the probe), or an invalid Hit.
-    Hit at(const Vec3f& p, float scale, const Vec3f& n) const {
+    /// (unit normal n), in the scene's ids (t along the probe), or an invalid Hit. No probe is
+    /// traced when p is farther than that reach from the bounds of every opaque object kept (most
+    /// hits on a candidate: a panel standing on the floor touches it along one edge).
+    Hit at(const Vec3f& p, float scale, const Vec3f& n, RayCounters& counters) const {
+        const float reach = guaranteed_gap(p, scale);
+        for (int k = 0; k < 3; ++k)
+            if (double(p[k]) < m_bounds.lo[k] - double(reach) || double(p[k]) > m_bounds.hi[k] + double(reach)) return Hit{};
+        ++counters.contact_probe;
         Ray probe;
-        return probe_at(p, n, guaranteed_gap(p, scale), probe);
+        return probe_at(p, n, reach, probe);
     }
 
     // SurfaceFilter: every face of an opaque object covers (masked and blended ones are not kept).
@@ -514,9 +511,7 @@ std::optional<WhittedIntegrator::OtherMedium> WhittedIntegrator::other_medium(co
 }
 
 std::optional<Hit> WhittedIntegrator::opaque_cover(const Hit& hit, const SurfacePoint& sp, RayCounters& counters) const {
-    if (!m_covers->near(sp.p, sp.offset_scale)) return std::nullopt;
-    ++counters.contact_probe;
-    Hit cover = m_covers->at(sp.p, sp.offset_scale, sp.ng);
+    Hit cover = m_covers->at(sp.p, sp.offset_scale, sp.ng, counters);
     if (!cover.valid()) return std::nullopt;
     cover.t = hit.t;  // the same ray's hit at the same distance (cone width, absorption)
     return cover;
