@@ -11,8 +11,8 @@
 //       largest pixel difference);
 //   (d) the "Whitted overhead": the rays of one render are recorded (through a decorator of the
 //       accelerator), then replayed through the bare accelerator with the same threads; renders
-//       and replays alternate, and the ratio (render Mrays/s / replay Mrays/s) is the median of
-//       the pairs';
+//       and replays alternate, and the ratio (render Mrays/s / replay Mrays/s) is the median over
+//       the pairs;
 //   (e) for scenes made only of triangle meshes, a private Embree scene built like the backend's
 //       (one BVH per mesh, one instance per Instance, build quality MEDIUM) measures rtcIntersect1
 //       against rtcIntersect4/8/16 on the recorded camera rays, rtcOccluded1 with and without an
