@@ -57,6 +57,9 @@ inline std::filesystem::path scratch_dir(const std::string& prefix, const std::s
     return dir;
 }
 
+/// Whether `part` occurs in `s` (the tests' check on captured output).
+inline bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
 /// A CSV as rows of column -> value. Fields may be double-quoted (bench skip quotes its kernel
 /// names, which hold commas; "" inside quotes is a quote). A row with the wrong number of fields
 /// also gets "_bad" = the line.
@@ -89,6 +92,11 @@ inline std::vector<std::map<std::string, std::string>> read_csv(const std::files
         rows.push_back(row);
     }
     return rows;
+}
+
+/// The number in `column` of a read_csv row (throws when the column is missing).
+inline double num(const std::map<std::string, std::string>& row, const std::string& column) {
+    return std::stod(row.at(column));
 }
 
 }  // namespace whitted::test

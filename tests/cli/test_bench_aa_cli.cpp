@@ -17,6 +17,7 @@
 namespace {
 
 namespace fs = std::filesystem;
+using whitted::test::num;
 using whitted::test::read_csv;
 using whitted::test::Result;
 using whitted::test::run;
@@ -31,8 +32,6 @@ Result bench(const fs::path& out, int steps) {
     return run("bench aa '" + kBox + "' --width 64 --ref-spp 64 --repeat 1 --threads 1 --no-plot --target-search " +
                std::to_string(steps) + " --out '" + out.string() + "' --cache '" + (out / "cache").string() + "'");
 }
-
-double num(const Row& r, const char* col) { return std::stod(r.at(col)); }
 
 /// The bench's label rounding: three significant digits.
 float round3(double t) {
@@ -116,10 +115,6 @@ TEST(BenchAaCli, NoSearchWithZeroSteps) {
     EXPECT_EQ(r.out.find("(threshold search)"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("target adaptive <= 1/3 time of stratified 16"), std::string::npos) << r.out;
 }
-
-}  // namespace
-
-namespace {
 
 // --only runs the labelled settings; an adaptive label outside the sweep (as the search prints
 // them) is run too, and anything else is one error line and a non-zero exit.

@@ -17,6 +17,7 @@
 namespace {
 
 namespace fs = std::filesystem;
+using whitted::test::contains;
 using whitted::test::read_csv;
 using whitted::test::Result;
 using whitted::test::run;
@@ -24,7 +25,6 @@ using whitted::test::slurp;
 
 fs::path temp_dir(const std::string& name) { return whitted::test::scratch_dir("whitted_bench_accel_cli", name); }
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 const std::string kWhitted1980 = std::string(WHITTED_ASSETS_DIR) + "/scenes/whitted1980.json";
 

@@ -6,40 +6,27 @@
 #include "cli_image.h"
 #include "cli_util.h"
 
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <string>
 #include <vector>
 
 namespace {
 
 namespace fs = std::filesystem;
+using whitted::test::contains;
+using whitted::test::num;
 using whitted::test::read_csv;
 using whitted::test::read_pixels;
 using whitted::test::Result;
 using whitted::test::run;
-using whitted::test::slurp;
 
-
-fs::path temp_dir() {
-    const fs::path dir = fs::temp_directory_path() / ("whitted_skip_cli_" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    return dir;
-}
-
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+fs::path temp_dir(const std::string& name) { return whitted::test::scratch_dir("whitted_skip_cli", name); }
 
 const std::string kScene = std::string(WHITTED_ASSETS_DIR) + "/scenes/whitted1980.json";
 
 TEST(SkipCli, NoSpecializeSelectsTheGeneralKernelWithTheSameImage) {
-    const fs::path general = temp_dir() / "general.exr", special = temp_dir() / "special.exr";
+    const fs::path general = temp_dir("kernels") / "general.exr", special = temp_dir("kernels") / "special.exr";
     const std::string common = "render '" + kScene + "' --width 64 --height 48 --aa adaptive --min-weight 0 --exr-float --no-progress";
     const Result g = run(common + " --no-specialize -o '" + general.string() + "'");
     ASSERT_EQ(g.code, 0) << g.err;
@@ -54,7 +41,7 @@ TEST(SkipCli, NoSpecializeSelectsTheGeneralKernelWithTheSameImage) {
 }
 
 TEST(SkipCli, RenderLogPrintsTheAnalysisAndTheDefaultMinWeight) {
-    const fs::path out = temp_dir() / "log.png";
+    const fs::path out = temp_dir("log") / "log.png";
     const Result r = run("render '" + kScene + "' --width 32 --height 24 --aa center --no-progress -o '" + out.string() + "'");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(contains(r.err, "analysis: opaque=no recursive=yes mirror=yes transmission=yes")) << r.err;
@@ -74,13 +61,12 @@ TEST(SkipCli, InfoPrintsTheAnalysis) {
 // min_weight 0 (whole render and camera pass), the min-weight sweep only removes secondary rays,
 // and the Whitted overhead replays exactly the rays the render counted.
 TEST(SkipCli, BenchSkipReplaysTheRaysTheRenderCounted) {
-    const fs::path out = temp_dir() / "bench";
+    const fs::path out = temp_dir("bench");
     const Result r = run("bench skip '" + kScene + "' --width 96 --repeat 2 --threads 1 --no-plot --no-packets -o '" +
                          out.string() + "'");
     ASSERT_EQ(r.code, 0) << r.out << r.err;
     EXPECT_TRUE(contains(r.out, "(median of 2 render/replay pairs;")) << r.out;
 
-    auto num = [](const std::map<std::string, std::string>& row, const char* column) { return std::stod(row.at(column)); };
     const auto rows = read_csv(out / "skip.csv");
     ASSERT_EQ(rows.size(), 2u + 6u);  // general and specialised, then the default sweep without its 0
     std::map<std::string, std::string> at_default;
