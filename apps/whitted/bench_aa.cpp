@@ -463,14 +463,13 @@ int run_bench_aa(const BenchAaOptions& o) {
             for (const Run& r : runs) candidates.push_back(&r);
             for (const Run& r : searched) candidates.push_back(&r);
             const Run* best = nullptr;
-            for (const Run* r : candidates)
-                if (r->aa.mode == AaMode::Adaptive && r->rmse_disp <= s16->rmse_disp && (!best || r->seconds < best->seconds)) best = r;
             // Also by total rays traced: a cost that does not depend on the machine's load.
             const Run* fewest = nullptr;
-            for (const Run* r : candidates)
-                if (r->aa.mode == AaMode::Adaptive && r->rmse_disp <= s16->rmse_disp &&
-                    (!fewest || r->stats.rays.total() < fewest->stats.rays.total()))
-                    fewest = r;
+            for (const Run* r : candidates) {
+                if (r->aa.mode != AaMode::Adaptive || r->rmse_disp > s16->rmse_disp) continue;
+                if (!best || r->seconds < best->seconds) best = r;
+                if (!fewest || r->stats.rays.total() < fewest->stats.rays.total()) fewest = r;
+            }
             auto rays_ratio = [&](const Run& r) { return double(r.stats.rays.total()) / double(s16->stats.rays.total()); };
             if (best) {
                 std::printf("   target adaptive <= 1/3 time of stratified 16 at its display RMSE %.5f%s: %s at %.3fx time "
