@@ -94,6 +94,32 @@ TEST(IntegratorAnalytic, BlinnPhongHighlight) {
     expect_color_near(render_pixel(s, 3, 3, 2, 1), want);
 }
 
+// The specular cutoff: where n (1 - N.H) >= 17 the highlight (< e^-17 = 4.2e-8 of ks Is) is not
+// evaluated. A highlight-only floor (kd = ka = 0, no ambient), N.H = cos(22.5 deg) = 0.924 at the
+// pixel: with n = 300 it lies past the cutoff and the pixel is 0, within 4.2e-8 ks Is of the exact
+// value; with n = 200 (n (1 - N.H) = 15.2) it is evaluated as the formula says.
+TEST(IntegratorAnalytic, HighlightBelowTwoToMinus24OfKsIsNotEvaluated) {
+    const Color ks{0.3f};
+    const Vec3f L = normalize(Vec3f{-2, 0, 2});
+    const float n_dot_h = normalize(L + Vec3f{0, 0, 1}).z;
+    for (const float n : {300.f, 200.f}) {
+        SCOPED_TRACE(n);
+        Scene s;
+        add_floor(s, add_classic_material(s, diffuse(Color(0.f), ks, n)));
+        s.lights.push_back(point_light({0, 0, 2}, 8.f));  // Is fat = 8 / 8 = 1 at (2, 0, 0)
+        s.cameras.push_back(top_down_ortho(3.0));
+        const Color got = render_pixel(s, 3, 3, 2, 1, 5, Color(0.f));
+        const float exact = ks.x * std::pow(n_dot_h, n);
+        ASSERT_GT(exact, 0.f);
+        EXPECT_LE(std::abs(got.x - exact), 4.2e-8f * ks.x);
+        if (n * (1.f - n_dot_h) >= 17.f) {
+            EXPECT_EQ(got.x, 0.f);
+        } else {
+            EXPECT_NEAR(got.x, exact, exact * 1e-4f);
+        }
+    }
+}
+
 TEST(IntegratorAnalytic, NoLightFromBehindTheSurface) {
     Scene s;
     add_floor(s, add_classic_material(s, diffuse(Color(0.5f))));
