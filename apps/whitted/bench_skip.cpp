@@ -12,7 +12,10 @@
 //   (d) the "Whitted overhead": the rays of one render are recorded (through a decorator of the
 //       accelerator), then replayed through the bare accelerator with the same threads; renders
 //       and replays alternate, and the ratio (render Mrays/s / replay Mrays/s) is the median over
-//       the pairs;
+//       the pairs. One more render and replay, each through a decorator that adds up the ticks
+//       spent inside the accelerator's queries, split the render into traversal and the rest:
+//       the traversal's share of the render, and its ticks against the replay's (1 = the rays
+//       cost the same inside the render as bare);
 //   (e) for scenes made only of triangle meshes, a private Embree scene built like the backend's
 //       (one BVH per mesh, one instance per Instance, build quality MEDIUM) measures rtcIntersect1
 //       against rtcIntersect4/8/16 on the recorded camera rays, rtcOccluded1 with and without an
@@ -432,7 +435,8 @@ int run_bench_skip(const BenchSkipOptions& o) {
     csv << "scene,variant,kernel,min_weight,clock,median_s,min_s,load,camera,shadow,reflection,refraction,secondary,total,"
            "mrays_per_s,shadow_skipped_unreached,shadow_skipped_facing,secondary_skipped_cutoff,differing_pixels,"
            "max_abs,rmse_linear,rmse_display\n";
-    ocsv << "scene,threads,clock,rays,camera,shadow,secondary,render_s,render_mrays,replay_s,replay_mrays,overhead_ratio,load\n";
+    ocsv << "scene,threads,clock,rays,camera,shadow,secondary,render_s,render_mrays,replay_s,replay_mrays,overhead_ratio,load,"
+            "render_traversal_share,traversal_render_over_replay\n";
     pcsv << "scene,query,width,threads,mrays_per_s,load\n";
     std::ofstream ccsv(out / "skip_camera_pass.csv");
     ccsv << "scene,variant,min_weight,clock,median_s,rays,camera,mrays_per_s,speedup_vs_general,differing_pixels,"
@@ -592,6 +596,21 @@ int run_bench_skip(const BenchSkipOptions& o) {
                 pair_ratio.push_back(replay_t.back() / render_t.back());
             }
             const double render_s = median(render_t), replay = median(replay_t), ratio = median(pair_ratio);
+            // Where the render's time goes: the ticks inside the accelerator against the whole
+            // render, and against a replay of the same rays through the same decorator.
+            double traversal_share = 0.0, traversal_vs_replay = 0.0;
+            {
+                const TimingAccelerator in_render(renderer.accelerator()), in_replay(renderer.accelerator());
+                const uint64_t t0 = ticks();
+                (void)renderer.render(rs.aa, is, in_render, nullptr);
+                const uint64_t render_ticks = ticks() - t0;
+                (void)replay_seconds(in_replay, rays, threads, 1);
+                // Summed over the threads: against the render's ticks on every thread (all busy).
+                traversal_share = double(in_render.traversal_ticks()) /
+                                  (double(std::max<uint64_t>(1, render_ticks)) * double(threads));
+                traversal_vs_replay =
+                    double(in_render.traversal_ticks()) / double(std::max<uint64_t>(1, in_replay.traversal_ticks()));
+            }
             const double render_mr = double(rays.size()) / render_s * 1e-6;
             const double replay_mr = double(rays.size()) / replay * 1e-6;
             const double load = load_average();
@@ -599,10 +618,13 @@ int run_bench_skip(const BenchSkipOptions& o) {
                         "= %.2f Mrays/s, ratio %.3f (median of %zu render/replay pairs; target >= 0.70: %s) | load %.2f\n",
                         rays.size(), render_s, render_mr, replay, replay_mr, ratio, pair_ratio.size(),
                         ratio >= 0.7 ? "met" : "NOT met", load);
-            ocsv << fmt::format("{},{},{},{},{},{},{},{:.6f},{:.4f},{:.6f},{:.4f},{:.4f},{:.2f}\n", label, threads,
-                                g_cpu_clock ? "cpu" : "wall", rays.size(),
-                                st.rays.camera, st.rays.shadow, st.rays.secondary(), render_s, render_mr, replay,
-                                replay_mr, ratio, load);
+            std::printf("   traversal inside the render: %.1f%% of its time (the rest: shading, surfaces, camera, "
+                        "film); the same queries take %.3fx the replay's traversal time\n",
+                        100.0 * traversal_share, traversal_vs_replay);
+            ocsv << fmt::format("{},{},{},{},{},{},{},{:.6f},{:.4f},{:.6f},{:.4f},{:.4f},{:.2f},{:.4f},{:.4f}\n", label,
+                                threads, g_cpu_clock ? "cpu" : "wall", rays.size(), st.rays.camera, st.rays.shadow,
+                                st.rays.secondary(), render_s, render_mr, replay, replay_mr, ratio, load,
+                                traversal_share, traversal_vs_replay);
 
             // (e) packets, filters and BVH bytes on a private Embree scene (meshes only).
             if (o.packets && mesh_only(scene)) {

@@ -104,6 +104,11 @@ TEST(SkipCli, BenchSkipReplaysTheRaysTheRenderCounted) {
     EXPECT_NEAR(num(o, "render_mrays"), num(o, "rays") / num(o, "render_s") * 1e-6, 0.01 * num(o, "render_mrays"));
     EXPECT_NEAR(num(o, "replay_mrays"), num(o, "rays") / num(o, "replay_s") * 1e-6, 0.01 * num(o, "replay_mrays"));
     EXPECT_GT(num(o, "overhead_ratio"), 0.0);
+    // The traversal is a part of the render (one thread), and the decorator saw the replay's queries.
+    EXPECT_GT(num(o, "render_traversal_share"), 0.0);
+    EXPECT_LT(num(o, "render_traversal_share"), 1.0);
+    EXPECT_GT(num(o, "traversal_render_over_replay"), 0.0);
+    EXPECT_TRUE(contains(r.out, "traversal inside the render: ")) << r.out;
 
     // The camera pass: ray by ray and in packets, the specialised kernel gives the general image.
     const auto pass = read_csv(out / "skip_camera_pass.csv");
