@@ -433,7 +433,7 @@ int run_bench_skip(const BenchSkipOptions& o) {
     const DisplayTransform display(ColorSettings{});
     std::ofstream csv(out / "skip.csv"), ocsv(out / "skip_overhead.csv"), pcsv(out / "skip_packets.csv");
     csv << "scene,variant,kernel,min_weight,clock,median_s,min_s,load,camera,shadow,reflection,refraction,secondary,total,"
-           "mrays_per_s,shadow_skipped_unreached,shadow_skipped_facing,secondary_skipped_cutoff,differing_pixels,"
+           "mrays_per_s,shadow_skipped_unreached,shadow_skipped_facing,shadow_skipped_zero,secondary_skipped_cutoff,differing_pixels,"
            "max_abs,rmse_linear,rmse_display\n";
     ocsv << "scene,threads,clock,rays,camera,shadow,secondary,render_s,render_mrays,replay_s,replay_mrays,overhead_ratio,load,"
             "render_traversal_share,traversal_render_over_replay\n";
@@ -481,10 +481,10 @@ int run_bench_skip(const BenchSkipOptions& o) {
                         (unsigned long long)r.reflection, (unsigned long long)r.refraction, mr,
                         (unsigned long long)d.differing_pixels, d.max_abs, d.rmse_linear, d.rmse_display, m.load);
             std::fflush(stdout);
-            csv << fmt::format("{},{},\"{}\",{:g},{},{:.6f},{:.6f},{:.2f},{},{},{},{},{},{},{:.4f},{},{},{},{},{:.6g},{:.6g},{:.6g}\n",
+            csv << fmt::format("{},{},\"{}\",{:g},{},{:.6f},{:.6f},{:.2f},{},{},{},{},{},{},{:.4f},{},{},{},{},{},{:.6g},{:.6g},{:.6g}\n",
                                label, variant, kernel_name(k), mw, g_cpu_clock ? "cpu" : "wall", m.median_seconds, m.min_seconds, m.load, r.camera,
                                r.shadow, r.reflection, r.refraction, r.secondary(), r.total(), mr,
-                               r.shadow_skipped_unreached, r.shadow_skipped_facing, r.secondary_skipped_cutoff,
+                               r.shadow_skipped_unreached, r.shadow_skipped_facing, r.shadow_skipped_zero, r.secondary_skipped_cutoff,
                                d.differing_pixels, d.max_abs, d.rmse_linear, d.rmse_display);
         };
 

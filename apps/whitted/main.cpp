@@ -268,7 +268,7 @@ int run_render(RenderOptions o, const std::string& cmdline, Given&& given) {
                  "whitted: wrote %s (%dx%d)\n"
                  "  time   load %.3fs  build %.3fs  render %.3fs  write %.3fs\n"
                  "  rays   camera %llu  shadow %llu  reflection %llu  refraction %llu  total %llu\n"
-                 "  skip   %s; shadow rays not cast: %llu unreached, %llu facing away; "
+                 "  skip   %s; shadow rays not cast: %llu unreached, %llu facing away, %llu with a zero term; "
                  "secondary rays below --min-weight %g: %llu\n"
                  "  speed  %.2f Mrays/s on %d threads\n"
                  "  aa     %s: %.3f camera rays/pixel, %.1f%% pixels subdivided\n",
@@ -277,7 +277,8 @@ int run_render(RenderOptions o, const std::string& cmdline, Given&& given) {
                  (unsigned long long)stats.rays.reflection, (unsigned long long)stats.rays.refraction,
                  (unsigned long long)rays, kernel_name(renderer.kernel()).c_str(),
                  (unsigned long long)stats.rays.shadow_skipped_unreached,
-                 (unsigned long long)stats.rays.shadow_skipped_facing, double(o.min_weight),
+                 (unsigned long long)stats.rays.shadow_skipped_facing,
+                 (unsigned long long)stats.rays.shadow_skipped_zero, double(o.min_weight),
                  (unsigned long long)stats.rays.secondary_skipped_cutoff, mrays, stats.threads, o.aa.c_str(),
                  stats.pixels ? double(stats.rays.camera) / double(stats.pixels) : 0.0, 100.0 * subdivided);
     return 0;

@@ -604,6 +604,23 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                 ++counters.shadow_skipped_facing;
                 return;
             }
+            // The light's term at the point, before its shadow factor.
+            Color local = c.kd * n_dot_l;
+            if (!is_black(c.ks)) {
+                const Vec3f H = normalize(ls.L + V);
+                const float n_dot_h = std::max(0.f, dot(N, H));
+                // x^n <= e^(-n (1 - x)) (as ln x <= x - 1): where n (1 - x) >= 17 the highlight is
+                // below 4.2e-8 (< 2^-24) of ks Is, invisible in every output (half's smallest normal
+                // is 6e-5), and its pow is not evaluated. With the usual n of 40-300 that is most
+                // points away from the highlight (docs/performance.md: the specular cutoff).
+                if (c.n * (1.f - n_dot_h) < 17.f) local += c.ks * std::pow(n_dot_h, c.n);
+            }
+            // Nothing for the shadow factor to scale (kd = 0 and the highlight below the cutoff: a
+            // glass or chrome surface away from its highlight): the shadow ray is not cast.
+            if (is_black(local)) {
+                ++counters.shadow_skipped_zero;
+                return;
+            }
             if (!have_shadow_org) {
                 shadow_org = m_offset.origin(front ? sp.p_shadow : sp.p, sp.offset_scale, Ng);
                 have_shadow_org = true;
@@ -623,16 +640,6 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
             count(counters, RayKind::Shadow);
             const Color s = m_accel.transmittance(shadow);
             if (is_black(s)) return;
-            Color local = c.kd * n_dot_l;
-            if (!is_black(c.ks)) {
-                const Vec3f H = normalize(ls.L + V);
-                const float n_dot_h = std::max(0.f, dot(N, H));
-                // x^n <= e^(-n (1 - x)) (as ln x <= x - 1): where n (1 - x) >= 17 the highlight is
-                // below 4.2e-8 (< 2^-24) of ks Is, invisible in every output (half's smallest normal
-                // is 6e-5), and its pow is not evaluated. With the usual n of 40-300 that is most
-                // points away from the highlight (docs/performance.md: the specular cutoff).
-                if (c.n * (1.f - n_dot_h) < 17.f) local += c.ks * std::pow(n_dot_h, c.n);
-            }
             // Opaque scenes: s is exactly 1 here (nothing passes partially), and x * 1 == x.
             if constexpr (K.transmission) result += ls.intensity * s * local;
             else result += ls.intensity * local;

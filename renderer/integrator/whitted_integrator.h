@@ -54,14 +54,16 @@ std::string kernel_name(const KernelFeatures& k);
 /// `aov_probe` counts first-hit-only rays through pixel centres that feed AOVs in modes without a
 /// centre sample. The `*_skipped` counters are not rays: shadow rays not cast because the light
 /// cannot reach the point (beyond its range, outside its cone or culled per object by the scene
-/// analysis: `unreached`) or lies behind the surface (N.L <= 0: `facing`), and secondary rays
+/// analysis: `unreached`), lies behind the surface (N.L <= 0: `facing`) or gives the point nothing
+/// to shadow (kd = 0 and the highlight below the specular cutoff: `zero`), and secondary rays
 /// not traced because their weight fell below min_weight (`cutoff`). `contact_probe` counts the
 /// short queries for a coincident face (a touching dielectric's, or an opaque surface under a thin
 /// transmissive one: in the integrator's own small structures, not the scene's accelerator; not
 /// in total()).
 struct RayCounters {
     uint64_t camera = 0, shadow = 0, reflection = 0, refraction = 0, aov_probe = 0;
-    uint64_t shadow_skipped_unreached = 0, shadow_skipped_facing = 0, secondary_skipped_cutoff = 0;
+    uint64_t shadow_skipped_unreached = 0, shadow_skipped_facing = 0, shadow_skipped_zero = 0;
+    uint64_t secondary_skipped_cutoff = 0;
     uint64_t contact_probe = 0;
     uint64_t total() const { return camera + shadow + reflection + refraction + aov_probe; }
     uint64_t secondary() const { return reflection + refraction; }
@@ -70,6 +72,7 @@ struct RayCounters {
         aov_probe += o.aov_probe;
         shadow_skipped_unreached += o.shadow_skipped_unreached;
         shadow_skipped_facing += o.shadow_skipped_facing;
+        shadow_skipped_zero += o.shadow_skipped_zero;
         secondary_skipped_cutoff += o.secondary_skipped_cutoff;
         contact_probe += o.contact_probe;
         return *this;

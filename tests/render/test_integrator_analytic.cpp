@@ -95,29 +95,42 @@ TEST(IntegratorAnalytic, BlinnPhongHighlight) {
 }
 
 // The specular cutoff: where n (1 - N.H) >= 17 the highlight (< e^-17 = 4.2e-8 of ks Is) is not
-// evaluated. A highlight-only floor (kd = ka = 0, no ambient), N.H = cos(22.5 deg) = 0.924 at the
-// pixel: with n = 300 it lies past the cutoff and the pixel is 0, within 4.2e-8 ks Is of the exact
-// value; with n = 200 (n (1 - N.H) = 15.2) it is evaluated as the formula says.
-TEST(IntegratorAnalytic, HighlightBelowTwoToMinus24OfKsIsNotEvaluated) {
+// evaluated, and a point whose light term is then 0 casts no shadow ray. A highlight-only floor
+// (kd = ka = 0, no ambient) seen at the origin, the light at (2, 0, 2): Is fat = 8 / 8 = 1 and
+// N.H = cos(22.5 deg) = 0.924. With n = 300 the highlight lies past the cutoff: the pixel is 0
+// (within 4.2e-8 ks of the exact value) and no shadow ray is cast; with n = 200 (n (1 - N.H) =
+// 15.2) it is evaluated as the formula says, under one shadow ray. Both kernels agree.
+TEST(IntegratorAnalytic, HighlightBelowTwoToMinus24OfKsIsNotEvaluatedNorShadowed) {
     const Color ks{0.3f};
-    const Vec3f L = normalize(Vec3f{-2, 0, 2});
+    const Vec3f L = normalize(Vec3f{2, 0, 2});
     const float n_dot_h = normalize(L + Vec3f{0, 0, 1}).z;
-    for (const float n : {300.f, 200.f}) {
-        SCOPED_TRACE(n);
-        Scene s;
-        add_floor(s, add_classic_material(s, diffuse(Color(0.f), ks, n)));
-        s.lights.push_back(point_light({0, 0, 2}, 8.f));  // Is fat = 8 / 8 = 1 at (2, 0, 0)
-        s.cameras.push_back(top_down_ortho(3.0));
-        const Color got = render_pixel(s, 3, 3, 2, 1, 5, Color(0.f));
-        const float exact = ks.x * std::pow(n_dot_h, n);
-        ASSERT_GT(exact, 0.f);
-        EXPECT_LE(std::abs(got.x - exact), 4.2e-8f * ks.x);
-        if (n * (1.f - n_dot_h) >= 17.f) {
-            EXPECT_EQ(got.x, 0.f);
-        } else {
-            EXPECT_NEAR(got.x, exact, exact * 1e-4f);
+    for (const float n : {300.f, 200.f})
+        for (const bool specialize : {false, true}) {
+            SCOPED_TRACE(testing::Message() << "n " << n << " specialize " << specialize);
+            Scene s;
+            add_floor(s, add_classic_material(s, diffuse(Color(0.f), ks, n)));
+            s.lights.push_back(point_light({2, 0, 2}, 8.f));
+            s.cameras.push_back(top_down_ortho(0.5));
+            RenderSettings rs;
+            rs.width = rs.height = 1;
+            rs.threads = 1;
+            rs.integrator.ambient = Color(0.f);
+            rs.integrator.specialize = specialize;
+            RenderStats stats;
+            const float got = Renderer(s, rs).render(&stats).beauty[0].x;
+            const float exact = ks.x * std::pow(n_dot_h, n);
+            ASSERT_GT(exact, 0.f);
+            EXPECT_LE(std::abs(got - exact), 4.2e-8f * ks.x);
+            if (n * (1.f - n_dot_h) >= 17.f) {
+                EXPECT_EQ(got, 0.f);
+                EXPECT_EQ(stats.rays.shadow, 0u);
+                EXPECT_EQ(stats.rays.shadow_skipped_zero, 1u);
+            } else {
+                EXPECT_NEAR(got, exact, exact * 1e-4f);
+                EXPECT_EQ(stats.rays.shadow, 1u);
+                EXPECT_EQ(stats.rays.shadow_skipped_zero, 0u);
+            }
         }
-    }
 }
 
 TEST(IntegratorAnalytic, NoLightFromBehindTheSurface) {

@@ -41,6 +41,7 @@ void expect_same_rays(const RayCounters& a, const RayCounters& b) {
     EXPECT_EQ(a.refraction, b.refraction);
     EXPECT_EQ(a.shadow_skipped_unreached, b.shadow_skipped_unreached);
     EXPECT_EQ(a.shadow_skipped_facing, b.shadow_skipped_facing);
+    EXPECT_EQ(a.shadow_skipped_zero, b.shadow_skipped_zero);
 }
 
 RenderSettings small_settings(const Scene& scene, int width) {

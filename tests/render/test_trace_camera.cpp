@@ -51,7 +51,7 @@ bool same(const PrimaryInfo& a, const PrimaryInfo& b) {
 bool same_counts(const RayCounters& a, const RayCounters& b) {
     return a.camera == b.camera && a.shadow == b.shadow && a.reflection == b.reflection &&
            a.refraction == b.refraction && a.shadow_skipped_unreached == b.shadow_skipped_unreached &&
-           a.shadow_skipped_facing == b.shadow_skipped_facing &&
+           a.shadow_skipped_facing == b.shadow_skipped_facing && a.shadow_skipped_zero == b.shadow_skipped_zero &&
            a.secondary_skipped_cutoff == b.secondary_skipped_cutoff && a.contact_probe == b.contact_probe;
 }
 
