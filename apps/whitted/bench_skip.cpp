@@ -12,10 +12,10 @@
 //   (d) the "Whitted overhead": the rays of one render are recorded (through a decorator of the
 //       accelerator), then replayed through the bare accelerator with the same threads; renders
 //       and replays alternate, and the ratio (render Mrays/s / replay Mrays/s) is the median over
-//       the pairs. One more render and replay, each through a decorator that adds up the ticks
+//       the pairs. Then --repeat more pairs, each through a decorator that adds up the ticks
 //       spent inside the accelerator's queries, split the render into traversal and the rest:
 //       the traversal's share of the render, and its ticks against the replay's (1 = the rays
-//       cost the same inside the render as bare);
+//       cost the same inside the render as bare), medians over the pairs;
 //   (e) for scenes made only of triangle meshes, a private Embree scene built like the backend's
 //       (one BVH per mesh, one instance per Instance, build quality MEDIUM) measures rtcIntersect1
 //       against rtcIntersect4/8/16 on the recorded camera rays, rtcOccluded1 with and without an
@@ -598,19 +598,21 @@ int run_bench_skip(const BenchSkipOptions& o) {
             const double render_s = median(render_t), replay = median(replay_t), ratio = median(pair_ratio);
             // Where the render's time goes: the ticks inside the accelerator against the whole
             // render, and against a replay of the same rays through the same decorator.
-            double traversal_share = 0.0, traversal_vs_replay = 0.0;
-            {
+            // Pairs again (render, replay, ...), medians of each fraction.
+            std::vector<double> shares, vs_replay;
+            for (int i = 0; i < std::max(1, o.repeat); ++i) {
                 const TimingAccelerator in_render(renderer.accelerator()), in_replay(renderer.accelerator());
                 const uint64_t t0 = ticks();
                 (void)renderer.render(rs.aa, is, in_render, nullptr);
                 const uint64_t render_ticks = ticks() - t0;
                 (void)replay_seconds(in_replay, rays, threads, 1);
                 // Summed over the threads: against the render's ticks on every thread (all busy).
-                traversal_share = double(in_render.traversal_ticks()) /
-                                  (double(std::max<uint64_t>(1, render_ticks)) * double(threads));
-                traversal_vs_replay =
-                    double(in_render.traversal_ticks()) / double(std::max<uint64_t>(1, in_replay.traversal_ticks()));
+                shares.push_back(double(in_render.traversal_ticks()) /
+                                 (double(std::max<uint64_t>(1, render_ticks)) * double(threads)));
+                vs_replay.push_back(double(in_render.traversal_ticks()) /
+                                    double(std::max<uint64_t>(1, in_replay.traversal_ticks())));
             }
+            const double traversal_share = median(shares), traversal_vs_replay = median(vs_replay);
             const double render_mr = double(rays.size()) / render_s * 1e-6;
             const double replay_mr = double(rays.size()) / replay * 1e-6;
             const double load = load_average();
