@@ -412,12 +412,6 @@ double ns_per_ray(const Accelerator& accel, const std::vector<RecordedRay>& rays
     return best * 1e9 / double(rays.size());
 }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
-}
-
 std::string load_average() {
     std::ifstream in("/proc/loadavg");
     std::string a, b, c;

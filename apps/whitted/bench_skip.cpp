@@ -105,13 +105,6 @@ std::vector<std::string> default_scenes() {
 /// The 1-minute load average (the machine is shared: every figure is printed next to it).
 double load_average() { return load_average_1min(); }
 
-double median(std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 // ---- image differences ----
 
 struct ImageDiff {

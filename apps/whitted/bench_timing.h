@@ -1,10 +1,19 @@
 // Clocks for the benchmarks on a shared machine: process CPU time (time other processes hold the
-// cores does not count) and the load average printed next to every figure.
+// cores does not count), the load average printed next to every figure, a cheap tick count for
+// splitting a run's time, and the median of repeated runs.
 #pragma once
 
 #include <time.h>
 
+#if defined(__x86_64__) || defined(_M_X64)
+#include <x86intrin.h>
+#endif
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
 #include <cstdlib>
+#include <vector>
 
 namespace whitted::app {
 
@@ -28,6 +37,25 @@ inline double thread_cpu_seconds() {
 inline double load_average_1min() {
     double l[1] = {0.0};
     return getloadavg(l, 1) == 1 ? l[0] : -1.0;
+}
+
+/// A cheap monotonic tick count for splitting a run's time (only ratios of ticks are used): the
+/// time-stamp counter on x86-64 (a few ns to read), else the steady clock in ns.
+inline uint64_t ticks() {
+#if defined(__x86_64__) || defined(_M_X64)
+    return __rdtsc();
+#else
+    return uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                        std::chrono::steady_clock::now().time_since_epoch()).count());
+#endif
+}
+
+/// Median of repeated measurements (0 for none).
+inline double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 }  // namespace whitted::app

@@ -8,18 +8,14 @@
 
 #include <tbb/enumerable_thread_specific.h>
 
-#if defined(__x86_64__) || defined(_M_X64)
-#include <x86intrin.h>
-#endif
-
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "apps/whitted/bench_timing.h"
 #include "renderer/accel/accelerator.h"
 
 namespace whitted::app {
@@ -88,17 +84,6 @@ private:
     const Accelerator& m_inner;
     mutable tbb::enumerable_thread_specific<std::vector<RecordedRay>> m_log;
 };
-
-/// A cheap monotonic tick count for splitting a render's time (only ratios of ticks are used):
-/// the time-stamp counter on x86-64 (a few ns to read), else the steady clock in ns.
-inline uint64_t ticks() {
-#if defined(__x86_64__) || defined(_M_X64)
-    return __rdtsc();
-#else
-    return uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                        std::chrono::steady_clock::now().time_since_epoch()).count());
-#endif
-}
 
 /// A decorator of an Accelerator that adds up the ticks spent inside its queries (every thread
 /// into one atomic total): the traversal's part of a render, or of a replay of the render's rays.

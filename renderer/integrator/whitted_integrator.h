@@ -67,6 +67,7 @@ struct RayCounters {
     uint64_t contact_probe = 0;
     uint64_t total() const { return camera + shadow + reflection + refraction + aov_probe; }
     uint64_t secondary() const { return reflection + refraction; }
+    bool operator==(const RayCounters&) const = default;
     RayCounters& operator+=(const RayCounters& o) {
         camera += o.camera; shadow += o.shadow; reflection += o.reflection; refraction += o.refraction;
         aov_probe += o.aov_probe;

@@ -42,6 +42,7 @@ void expect_same_rays(const RayCounters& a, const RayCounters& b) {
     EXPECT_EQ(a.shadow_skipped_unreached, b.shadow_skipped_unreached);
     EXPECT_EQ(a.shadow_skipped_facing, b.shadow_skipped_facing);
     EXPECT_EQ(a.shadow_skipped_zero, b.shadow_skipped_zero);
+    EXPECT_TRUE(a == b) << "another counter differs (secondary_skipped_cutoff, aov_probe, contact_probe)";
 }
 
 RenderSettings small_settings(const Scene& scene, int width) {

@@ -48,13 +48,6 @@ bool same(const PrimaryInfo& a, const PrimaryInfo& b) {
            a.normal.z == b.normal.z && same(a.albedo, b.albedo) && a.prim == b.prim && a.inst == b.inst;
 }
 
-bool same_counts(const RayCounters& a, const RayCounters& b) {
-    return a.camera == b.camera && a.shadow == b.shadow && a.reflection == b.reflection &&
-           a.refraction == b.refraction && a.shadow_skipped_unreached == b.shadow_skipped_unreached &&
-           a.shadow_skipped_facing == b.shadow_skipped_facing && a.shadow_skipped_zero == b.shadow_skipped_zero &&
-           a.secondary_skipped_cutoff == b.secondary_skipped_cutoff && a.contact_probe == b.contact_probe;
-}
-
 struct Outcome {
     size_t rays = 0, hits = 0, ties = 0, batches = 0;
 };
@@ -118,7 +111,7 @@ Outcome compare_rows(const std::string& path, const std::string& accel, bool spe
     out.batches = counting.batches;
     // Ray counts: identical unless a tie changed what a pixel's ray tree did.
     if (out.ties == 0) {
-        EXPECT_TRUE(same_counts(batch_counts, single_counts));
+        EXPECT_TRUE(batch_counts == single_counts);
     }
     EXPECT_EQ(batch_counts.camera, out.rays);
     std::printf("[ trace_camera ] %s on %s, %s: %zu rays, %zu hits, %zu tie pixels, %zu batch queries\n",
