@@ -25,7 +25,6 @@ using whitted::test::slurp;
 
 fs::path temp_dir(const std::string& name) { return whitted::test::scratch_dir("whitted_bench_accel_cli", name); }
 
-
 const std::string kWhitted1980 = std::string(WHITTED_ASSETS_DIR) + "/scenes/whitted1980.json";
 
 TEST(BenchAccelCli, RecordsARendersRaysAndValidatesEveryBackend) {
