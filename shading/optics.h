@@ -23,6 +23,28 @@ inline std::optional<Vec3f> refract(const Vec3f& I, const Vec3f& N, float eta) {
     return normalize(I * eta + N * (eta * cos_i - cos_t));
 }
 
+/// Direction of the mirror ray at a surface seen from unit V (toward the viewer): V reflected about
+/// the shading normal N, or about the geometric normal Ng where N would send it under the surface
+/// (N and Ng on the viewer's side). Unit length.
+inline Vec3f mirror_direction(const Vec3f& V, const Vec3f& N, const Vec3f& Ng) {
+    Vec3f R = reflect(V, N);
+    if (dot(R, Ng) <= 0.f) R = reflect(V, Ng);
+    return normalize(R);
+}
+
+/// Direction of the transmitted ray for unit incident direction I at a surface with shading
+/// normal N and geometric normal Ng on the incident side: straight on through a thin-walled
+/// surface, else Snell refraction with eta = n_incident / n_transmitted. Nothing on total
+/// internal reflection, or where the refracted ray would not cross the geometric surface (then
+/// the transmitted weight goes to reflection).
+inline std::optional<Vec3f> transmitted_direction(const Vec3f& I, const Vec3f& N, const Vec3f& Ng, float eta,
+                                                  bool thin) {
+    if (thin) return I;
+    const std::optional<Vec3f> T = refract(I, N, eta);
+    if (T && dot(*T, Ng) < 0.f) return T;
+    return std::nullopt;
+}
+
 /// Schlick's approximation of the Fresnel reflectance for normal-incidence reflectance f0.
 inline Color schlick(const Color& f0, float cos_theta) {
     float c = std::clamp(1.f - cos_theta, 0.f, 1.f);
@@ -30,7 +52,7 @@ inline Color schlick(const Color& f0, float cos_theta) {
     return f0 + (Color(1.f) - f0) * c5;
 }
 
-/// The seed's mirror and transmission weights with the Fresnel option (--fresnel): the mirror
+/// Whitted's (1980) mirror and transmission weights with the Fresnel option (--fresnel): the mirror
 /// weight kr follows Schlick's F(theta) of the normal-incidence reflectance ks, and transmission
 /// takes what is left, kt (1 - F) / (1 - ks). `cos_v` = N.V clamped to [0, 1].
 struct FresnelWeights {

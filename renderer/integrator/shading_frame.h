@@ -1,5 +1,5 @@
-// Which way a surface faces the ray that hit it: the one orientation rule of the integrator
-// (WhittedIntegrator::shade and ::probe) and of the stress suite's energy bound, written once.
+// Which way a surface faces the ray that hit it, and the secondary rays that leave it: the one
+// orientation and offset rule of the integrator and of the stability probes' tracer.
 #pragma once
 
 #include "renderer/core/vecmath.h"
@@ -24,6 +24,15 @@ inline ShadingFrame shading_frame(const SurfacePoint& sp, const Vec3f& dir) {
     f.N = f.front ? sp.ns : -sp.ns;
     if (dot(f.N, f.V) <= 0.f) f.N = f.Ng;  // shading normal facing away from the viewer: fall back
     return f;
+}
+
+/// A secondary ray from sp along unit `dir`, its origin moved to the side `side` points to (+Ng:
+/// the viewer's side, -Ng: through the surface) by the accelerator's offset policy.
+inline Ray spawn_ray(const RayOffsetPolicy& offset, const SurfacePoint& sp, const Vec3f& side, const Vec3f& dir) {
+    Ray r;
+    r.org = offset.origin(sp.p, sp.offset_scale, side);
+    r.dir = dir;
+    return r;
 }
 
 }  // namespace whitted
