@@ -798,8 +798,9 @@ size_t nonfinite_values(const Film& film) {
 
 namespace {
 
-/// The integrator's ray tree (whitted_integrator.cpp) with the local model replaced by its
-/// bound: shadows and cosines at 1, every light counted.
+/// The integrator's ray tree with the local model replaced by its bound: shadows and cosines at
+/// 1, every light counted. Orientation, directions and offsets come from the integrator's own
+/// helpers (shading_frame.h, shading/optics.h), so only the tree's shape is written twice.
 class BoundTracer {
 public:
     BoundTracer(const SceneView& view, const Accelerator& accel, const IntegratorSettings& s)
@@ -826,26 +827,17 @@ public:
                 auto [kr, kt] = secondary_weights(c.ks, c.kr, c.kt, std::clamp(dot(N, V), 0.f, 1.f), m_s.fresnel);
                 const float wt = weight * max_component(kt);
                 if (!is_black(kt) && wt >= m_s.min_weight) {
-                    Ray t;
-                    t.org = m_offset.origin(sp.p, sp.offset_scale, -Ng);
-                    bool transmitted = true;
-                    if (c.thin) {
-                        t.dir = ray.dir;
+                    const auto dir = transmitted_direction(ray.dir, N, Ng, front ? 1.f / c.ior : c.ior, c.thin);
+                    if (dir) {
+                        const Ray t = spawn_ray(m_offset, sp, -Ng, *dir);
+                        result += kt * trace(t, RayKind::Refraction, depth + 1, secondary, wt);
                     } else {
-                        auto dir = refract(ray.dir, N, front ? 1.f / c.ior : c.ior);
-                        if (dir && dot(*dir, Ng) < 0.f) t.dir = *dir;
-                        else transmitted = false;
+                        kr += kt;  // total internal reflection
                     }
-                    if (transmitted) result += kt * trace(t, RayKind::Refraction, depth + 1, secondary, wt);
-                    else kr += kt;
                 }
                 const float wr = weight * max_component(kr);
                 if (!is_black(kr) && wr >= m_s.min_weight) {
-                    Vec3f R = reflect(V, N);
-                    if (dot(R, Ng) <= 0.f) R = reflect(V, Ng);
-                    Ray r;
-                    r.org = m_offset.origin(sp.p, sp.offset_scale, Ng);
-                    r.dir = normalize(R);
+                    const Ray r = spawn_ray(m_offset, sp, Ng, mirror_direction(V, N, Ng));
                     result += kr * trace(r, RayKind::Reflection, depth + 1, secondary, wr);
                 }
             }
@@ -855,9 +847,7 @@ public:
         if (mat.model == MaterialModel::GltfPbr && mat.alpha_mode == AlphaMode::Blend) {
             const float alpha = std::clamp(m_view.material_inputs(mat, sp).base_color.w, 0.f, 1.f);
             if (alpha < 1.f) {
-                Ray behind;
-                behind.org = m_offset.origin(sp.p, sp.offset_scale, -Ng);
-                behind.dir = ray.dir;
+                const Ray behind = spawn_ray(m_offset, sp, -Ng, ray.dir);
                 const Color b = depth < m_s.max_depth
                                     ? trace(behind, RayKind::Refraction, depth + 1, secondary, weight * (1.f - alpha))
                                     : m_s.background;
