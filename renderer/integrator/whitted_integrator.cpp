@@ -44,15 +44,16 @@ template <KernelFeatures K>
 Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCounters& counters,
                                PrimaryInfo* primary, const RayCone& cone, float weight) const {
     if (!hit.valid()) return m_settings.background;
-    const SurfacePoint sp = surface_point<K>(ray, hit, cone);
+    const MaterialFeatures& mf = features(hit);
+    const SurfacePoint sp = surface_point<K>(ray, hit, mf, cone);
     if constexpr (K.transmission) {
         // An opaque surface lying under a thin transmissive one is what the ray sees.
         if (const std::optional<Hit> cover = covering_surface(hit, sp, counters))
             return shade<K>(ray, *cover, depth, counters, primary, cone, weight);
     }
     WhittedCoeffs varying;
-    const WhittedCoeffs& c = coefficients<K>(hit, sp, varying);
-    const Shading s{ray, hit, sp, c, m_view.scene().materials[sp.material], features(hit), shading_frame(sp, ray.dir),
+    const WhittedCoeffs& c = coefficients<K>(mf, sp, varying);
+    const Shading s{ray, hit, sp, c, m_view.scene().materials[sp.material], mf, shading_frame(sp, ray.dir),
                     touching_medium<K>(hit, sp, c, counters), depth, RayCone{cone.width_at(hit.t), cone.spread},
                     weight};
     if (primary) *primary = first_hit(hit, s.f.N, c);
@@ -224,20 +225,21 @@ Color WhittedIntegrator::blend_behind(const Shading& s, const Color& radiance, R
 
 /// A constant material (no textures, no vertex colors) needs no UVs, colors or footprint.
 template <KernelFeatures K>
-SurfacePoint WhittedIntegrator::surface_point(const Ray& ray, const Hit& hit, const RayCone& cone) const {
+SurfacePoint WhittedIntegrator::surface_point(const Ray& ray, const Hit& hit, const MaterialFeatures& mf,
+                                              const RayCone& cone) const {
     if constexpr (!K.attributes) return m_view.surface<false>(ray, hit, cone);
     else if constexpr (!K.tables) return m_view.surface<true>(ray, hit, cone);
-    else return features(hit).varying ? m_view.surface<true>(ray, hit, cone) : m_view.surface<false>(ray, hit, cone);
+    else return mf.varying ? m_view.surface<true>(ray, hit, cone) : m_view.surface<false>(ray, hit, cone);
 }
 
 /// A constant material's coefficients come from the analysis' table (read in place, not copied);
 /// others are evaluated into `varying`.
 template <KernelFeatures K>
-const WhittedCoeffs& WhittedIntegrator::coefficients(const Hit& hit, const SurfacePoint& sp,
+const WhittedCoeffs& WhittedIntegrator::coefficients(const MaterialFeatures& mf, const SurfacePoint& sp,
                                                      WhittedCoeffs& varying) const {
     if constexpr (!K.tables) return varying = m_view.coefficients(sp);
-    else if constexpr (!K.attributes) return features(hit).constant;
-    else return features(hit).varying ? (varying = m_view.coefficients(sp)) : features(hit).constant;
+    else if constexpr (!K.attributes) return mf.constant;
+    else return mf.varying ? (varying = m_view.coefficients(sp)) : mf.constant;
 }
 
 /// The medium of a touching dielectric beyond a hit on a non-thin dielectric (contacts.h).

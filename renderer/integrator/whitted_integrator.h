@@ -120,9 +120,9 @@ private:
         return m_view.analysis().materials[m_view.scene().geom_material(hit.geom)];
     }
     template <KernelFeatures K>
-    SurfacePoint surface_point(const Ray& ray, const Hit& hit, const RayCone& cone) const;
+    SurfacePoint surface_point(const Ray& ray, const Hit& hit, const MaterialFeatures& mf, const RayCone& cone) const;
     template <KernelFeatures K>
-    const WhittedCoeffs& coefficients(const Hit& hit, const SurfacePoint& sp, WhittedCoeffs& varying) const;
+    const WhittedCoeffs& coefficients(const MaterialFeatures& mf, const SurfacePoint& sp, WhittedCoeffs& varying) const;
     template <KernelFeatures K>
     std::optional<OtherMedium> touching_medium(const Hit& hit, const SurfacePoint& sp, const WhittedCoeffs& c,
                                                RayCounters& counters) const;
