@@ -7,8 +7,8 @@
 
 #include <fmt/format.h>
 
-#include "renderer/scene/scene_analysis.h"
 #include "shading/material_mapping.h"
+#include "shading/scene_analysis.h"
 
 namespace whitted {
 

@@ -9,8 +9,8 @@
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/scene/scene.h"
-#include "renderer/scene/scene_analysis.h"
 #include "shading/material_mapping.h"
+#include "shading/scene_analysis.h"
 
 namespace whitted {
 

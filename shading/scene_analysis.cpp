@@ -1,6 +1,6 @@
 // Scene analysis at load: per-material features, their OR over the scene, and which lights can
 // reach which objects (range window, spot cone). See scene_analysis.h for the contracts.
-#include "renderer/scene/scene_analysis.h"
+#include "shading/scene_analysis.h"
 
 #include <algorithm>
 #include <cmath>
