@@ -26,7 +26,7 @@ MaterialFeatures material_features(const Material& m, const MappingOptions& mapp
     f.constant = map_material_constant(m, mapping);
     f.constant_alpha = std::clamp(m.base_color.w, 0.f, 1.f);
     if (m.model == MaterialModel::Classic) {
-        // The seed's coefficients; a colour texture or vertex colors only tint kd and ka.
+        // Whitted's (1980) coefficients; a colour texture or vertex colors only tint kd and ka.
         const WhittedCoeffs& c = m.classic;
         f.diffuse = !is_black(c.kd);
         f.highlight = !is_black(c.ks);
