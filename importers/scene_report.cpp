@@ -184,6 +184,7 @@ std::string describe_scene(const Scene& scene) {
         line(s);
     }
 
+    // Materials as the file gives them, then the Whitted coefficients of their factors alone.
     const MappingOptions mapping{};
     for (size_t i = 0; i < scene.materials.size(); ++i) {
         const Material& m = scene.materials[i];
