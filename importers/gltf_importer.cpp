@@ -49,9 +49,7 @@ namespace {
 
 using namespace gltf;
 
-// Documented in docs/lights.md and docs/gltf-support.md.
 constexpr size_t kMaxJsonDepth = 64;  ///< array/object nesting (docs/fuzzing.md)
-// The default camera and light are in scene_defaults.cpp (shared with the scene-file importer).
 
 // ---------------------------------------------------------------------------------------------
 // Reading the file

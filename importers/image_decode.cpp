@@ -19,7 +19,7 @@
 #define STBI_NO_STDIO
 #define STBI_MAX_DIMENSIONS 32768  // = kMaxImageSide (checked below)
 // stb_image 2.27 calls memcpy(NULL, src, 0) for a PNG whose first IDAT chunk is empty (no buffer
-// allocated yet): undefined behaviour that UBSan reports (fuzz finding, regression file
+// allocated yet): undefined behaviour that UBSan reports (regression file
 // tests/data/fuzz-regressions/image/ubsan-stbi-getn-null-memcpy.png). Inside stb only, memcpy
 // skips empty copies. <cstring> is included above, so stb's own #include <string.h> is a no-op.
 namespace {
@@ -79,7 +79,7 @@ namespace {
 
 /// PNG chunk lengths checked against the bytes present, up to IEND: stb_image grows its IDAT
 /// buffer to a chunk's declared length before reading it, so one chunk claiming 2 GiB in a small
-/// file would allocate 2 GiB (fuzz finding: tests/data/fuzz-regressions/image/oom-png-idat-length-2gib.png).
+/// file would allocate 2 GiB (tests/data/fuzz-regressions/image/oom-png-idat-length-2gib.png).
 /// Returns the reason for refusing, or an empty string.
 std::string check_png_chunks(const uint8_t* p, size_t n) {
     size_t at = 8;  // after the signature

@@ -492,7 +492,8 @@ private:
         if (const Json* ka = member(v, "ka")) c.ka = color_or_texture(*ka, "ka");
         m.classic_color_texture = ref;
 
-        // The seed's single Ks weights the highlight and the mirror ray; kr and highlight split it.
+        // Whitted's (1980) single ks weights the highlight and the mirror ray; kr and highlight
+        // set them apart.
         auto coeff = [&](const char* key, Color& out) {
             if (const Json* x = member(v, key)) {
                 if (x->is_string())
@@ -515,7 +516,7 @@ private:
         if (!(c.n > 0.f) || !std::isfinite(c.n)) fail(sub(ptr, "n"), "n is out of the float range");
         if (!(c.ior > 0.f) || !std::isfinite(c.ior)) fail(sub(ptr, "ior"), "ior is out of the float range");
 
-        // Energy: a hint, not an error (the seed's coefficients are the user's to choose).
+        // Energy: a hint, not an error (Whitted's coefficients are the user's to choose).
         const Color sum = c.kd + c.kr + c.kt;
         if (max_component(sum) > 1.f + 1e-3f) {
             const int ch = sum.x >= sum.y && sum.x >= sum.z ? 0 : sum.y >= sum.z ? 1 : 2;

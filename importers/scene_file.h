@@ -1,5 +1,5 @@
-// The whitted scene file: JSON that composes glTF files with the seed's own primitives
-// (spheres, planes, boxes, inline meshes), classic materials, lights, a camera and render
+// The whitted scene file: JSON that composes glTF files with analytic primitives (spheres,
+// planes), boxes, inline meshes, Whitted's (1980) materials, lights, a camera and render
 // settings (docs/scene-format.md, schema docs/scene-format.schema.json).
 #pragma once
 

@@ -7,8 +7,8 @@
 
 #include <fmt/format.h>
 
-#include "renderer/scene/scene_analysis.h"
 #include "shading/material_mapping.h"
+#include "shading/scene_analysis.h"
 
 namespace whitted {
 
@@ -184,6 +184,7 @@ std::string describe_scene(const Scene& scene) {
         line(s);
     }
 
+    // Materials as the file gives them, then the Whitted coefficients of their factors alone.
     const MappingOptions mapping{};
     for (size_t i = 0; i < scene.materials.size(); ++i) {
         const Material& m = scene.materials[i];

@@ -16,7 +16,7 @@ struct SceneAnalysis;
 /// analysis (describe_analysis, default mapping options).
 std::string describe_scene(const Scene& scene);
 
-/// What the renderer may skip for this scene (renderer/scene/scene_analysis.h): one `analysis:`
+/// What the renderer may skip for this scene (shading/scene_analysis.h): one `analysis:`
 /// line of scene-wide features, one `analysis memory:` line, one `analysis material[i]:` line per
 /// material and one `analysis light[i]:` line per light (objects it may reach / all objects).
 /// Also printed in the render log.

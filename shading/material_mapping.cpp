@@ -57,7 +57,7 @@ PbrSample constant_pbr_sample(const Material& material) {
 }
 
 WhittedCoeffs map_gltf_material(const Material& material, const PbrSample& sample, const MappingOptions& options) {
-    // Scene-file materials carry the seed's coefficients directly.
+    // Scene-file materials carry Whitted's (1980) coefficients directly.
     if (material.model == MaterialModel::Classic) return material.classic;
 
     WhittedCoeffs c;

@@ -1,4 +1,4 @@
-// glTF metallic-roughness -> the seed's Whitted coefficients (see docs/materials.md).
+// glTF metallic-roughness -> Whitted's (1980) coefficients (see docs/materials.md).
 //
 // How to use: at a hit point the caller looks up the material's textures (shading/texture_sampling)
 // and fills a PbrSample following the field contracts below, then calls map_gltf_material(). The
@@ -33,7 +33,7 @@ struct PbrSample {
     Color specular_color{1.f};             ///< specularColorFactor * specularColorTexture.rgb (linear, may exceed 1)
 };
 
-/// Maps the glTF inputs at a point to the seed's coefficients (m = metallic, t = transmission,
+/// Maps the glTF inputs at a point to Whitted's coefficients (m = metallic, t = transmission,
 /// r = roughness; F0d = dielectric F0 per KHR_materials_specular; max() = largest channel):
 ///   F0 = mix(F0d, baseColor, m),  F0d = min(ior_to_f0(ior) * specularColor, 1) * specular
 ///   kd = baseColor (1 - m)(1 - t)(1 - max F0d);  ka = kd * occlusion

@@ -79,7 +79,7 @@ inline float reduce_coordinate(float u, WrapMode mode) {
 
 /// Maps the texel index of a reduced coordinate into [0, n) (GL 4.6 table 8.20). Reduction
 /// bounds the index to [-1, n] (Repeat, ClampToEdge) or [-1, 2n] (MirroredRepeat), so one
-/// conditional add replaces the integer modulo that dominated the lookup's cost.
+/// conditional add replaces an integer modulo.
 inline int wrap_index(int i, int n, WrapMode mode) {
     switch (mode) {
         case WrapMode::Repeat:
@@ -279,8 +279,8 @@ namespace {
 /// I(x) = floor(x/2) + 2 max(x/2 - floor(x/2) - 1/2, 0) (pbrt-v3, Checkerboard2DTexture).
 double filtered_square_wave(double x, double w) {
     if (!(w > 1e-6)) {
-        // +1 on even cells: floor(x) / 2 is an integer (exact: halving an integer-valued double;
-        // the libm fmod this replaces was a call per axis and hit).
+        // +1 on even cells: floor(x) / 2 is an integer (exact: halving an integer-valued double,
+        // no fmod call).
         const double half = std::abs(std::floor(x)) * 0.5;
         return half == std::floor(half) ? 1.0 : -1.0;
     }

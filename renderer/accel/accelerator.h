@@ -1,4 +1,4 @@
-// Accelerator: the one interface every ray-query backend implements.
+// Accelerator: the one interface every ray-query backend implements (docs/accelerators.md).
 //
 // How to use:
 //   auto accel = create_accelerator("embree", scene, filter, config);   // builds once
@@ -7,18 +7,13 @@
 //   Color s = accel->transmittance(shadow_ray);                          // product of Kt along it
 //   auto ref = create_accelerator("bvh:precision=double", scene, filter); // double-precision reference
 //
-// The interface is virtual only at the per-ray boundary; traversal inside a backend is inlined.
-// A hit is the minimal record {t, u, v, prim, geom, inst}; shading data (normals, UVs, material)
-// is computed afterwards from it by the integrator (Mitsuba's PreliminaryIntersection idea).
-//
-// Surface decisions that need materials (alpha-mask cut-outs, back-face culling of camera rays,
-// the transmittance of a transparent surface) are asked of a SurfaceFilter the caller provides,
-// so backends never look at materials or textures themselves. The filter is consulted in the
-// same way for every kind of geometry (meshes, spheres, planes), by geometry id.
-//
-// Every backend handles Scene::spheres (analytic, in its own structure or as Embree user
-// geometry) and Scene::planes (infinite, tested beside the structure by a decorator that
-// create_accelerator adds; see docs/accelerators.md).
+// Virtual only at the per-ray boundary; traversal inside a backend is inlined. A hit is the
+// minimal record {t, u, v, prim, geom, inst}; the integrator computes shading data from it
+// afterwards (Mitsuba's PreliminaryIntersection). Decisions that need materials (alpha-mask
+// cut-outs, back-face culling of camera rays, transmittance) are asked of the caller's
+// SurfaceFilter by geometry id, so backends never read materials or textures. Every backend
+// traces Scene::spheres itself; Scene::planes are tested beside it by a decorator that
+// create_accelerator adds.
 #pragma once
 
 #include <cstdint>
@@ -75,7 +70,7 @@ public:
     virtual Color transmittance(const Ray& ray, const Hit& hit) const = 0;
     /// What geometry `geom` (mesh, sphere or plane id) needs from traversal: a combination of the
     /// SurfaceFilter::k* flags. Backends skip the filter calls a geometry does not need (a plain
-    /// opaque one needs none). The name predates spheres and planes.
+    /// opaque one needs none).
     ///
     /// The two flags are independent, one per query: kNeedsAccept is read by closest-hit queries
     /// only, kNeedsTransmittance by shadow queries only. Shadow rays never call accept(); a
@@ -110,8 +105,8 @@ struct RayOffsetPolicy {
     Vec3f origin(const Vec3f& p, float offset_scale, const Vec3f& n) const {
         return offset_ray_origin(p, scale_factor * offset_scale, n, ulps);
     }
-    /// gap_ulps units as a distance: nearer surfaces may be skipped (touching dielectrics are
-    /// looked for explicitly within it, renderer/integrator/whitted_integrator.cpp).
+    /// gap_ulps units as a distance: nearer surfaces may be skipped (the integrator looks for
+    /// touching dielectrics within it explicitly).
     float gap(const Vec3f& p, float offset_scale) const {
         return gap_ulps * detail::offset_unit(p, scale_factor * offset_scale);
     }
@@ -119,15 +114,15 @@ struct RayOffsetPolicy {
 
 /// Float traversal (Embree and the in-house float backends): its rounding is a few ulps of the
 /// primitive's coordinates, so origins move 4 ulps of max(max|p|, the primitive's coordinates)
-/// and every surface 12 of them away is hit. Measured: no offset gives both "no self-hit" and
-/// "every neighbour 4 ulps away hit" with float traversal (numerical-stability.md, section 1).
+/// and every surface 12 of them away is hit. No offset gives both "no self-hit" and "every
+/// neighbour 4 ulps away hit" with float traversal (docs/numerical-stability.md, section 1).
 inline constexpr RayOffsetPolicy kFloatRayOffset{detail::kOffsetUlps, 1.f, kGuaranteedGapUlps};
 
 /// Double traversal (bvh:precision=double, brute:precision=double): its rounding is ~2^-29 of a
 /// float ulp, so the origin need only be strictly off the surface. Half an ulp of
 /// max(max|p|, 2^-26 * the primitive's coordinates) (the 2^-26 floor keeps the unit above the
 /// double hit point's error near the world origin) plus the float rounding puts origins 0.5 to
-/// 2.5 units away, and every surface 4 ulps away is hit: the issue's 4 * ulp(max|p|) (issue #7).
+/// 2.5 units away, and every surface 4 ulps away is hit.
 inline constexpr RayOffsetPolicy kDoubleRayOffset{0.5f, 0x1p-26f, 4.f};
 
 class Accelerator {
@@ -165,8 +160,9 @@ const std::vector<std::string>& accelerator_names();
 /// Builds the named backend: "embree", "bvh", "grid", "octree", "kdop" or "brute" (the O(n)
 /// oracle), optionally followed by options, e.g. "bvh:precision=double,bv=sphere",
 /// "grid:lambda=8" or "embree:packet=8,compact=1" (docs/accelerators.md lists them). Throws
-/// whitted::Error naming the valid choices for an unknown name or option. `scene` and `filter` must outlive the accelerator,
-/// unchanged: backends may keep references to them (Embree shares the meshes' index arrays).
+/// whitted::Error naming the valid choices for an unknown name or option. `scene` and `filter`
+/// must outlive the accelerator, unchanged: backends may keep references to them (Embree shares
+/// the meshes' index arrays).
 std::unique_ptr<Accelerator> create_accelerator(const std::string& name, const Scene& scene,
                                                 const SurfaceFilter& filter, const AccelConfig& config = {});
 

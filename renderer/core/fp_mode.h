@@ -1,11 +1,7 @@
 // The floating-point mode tracing runs in: flush-to-zero and denormals-are-zero (SSE MXCSR),
-// which Embree expects in every thread that traces (denormal arithmetic is ~100x slower, and the
-// renderer's ray offsets never step into the denormals: renderer/core/ray_offset.h).
-//
-// Scoped, not set-and-forget: the renderer is a library (Python bindings and MPI workers will
-// call it from threads that do other float work), so the caller's mode is restored when the scope
-// ends. Worker threads entering the render's task arena get the same treatment through a TBB
-// observer (render.cpp).
+// which Embree expects in every thread that traces; ray offsets never step into the denormals
+// (renderer/core/ray_offset.h). Scoped, because the renderer is a library: the caller's mode is
+// restored when the scope ends. Render worker threads get the same through a TBB observer.
 #pragma once
 
 #include <xmmintrin.h>

@@ -1,7 +1,6 @@
 // Scratch arrays whose elements are left uninitialised: for per-batch buffers (64 rays, 64 hit
-// records) that a callee fills completely before anything reads them. std::array would run the
-// elements' default member initializers on every batch, which profiles showed as a visible share
-// of a cheap camera ray (docs/performance.md).
+// records) that a callee fills completely before anything reads them, where std::array would run
+// the elements' default member initializers on every batch (docs/performance.md).
 #pragma once
 
 #include <cstddef>

@@ -1,7 +1,7 @@
 // Small vector / matrix types used everywhere in whitted.
 //
 // Vec3f is the shading and ray type (float); Vec3d and Mat4d carry scene transforms, which are
-// composed in double precision (node hierarchies, later scale/offset stress tests).
+// composed in double precision (node hierarchies, large scales and offsets).
 #pragma once
 
 #include <algorithm>

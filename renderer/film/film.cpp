@@ -22,8 +22,7 @@ Film::Film(int full_width_, int full_height_, PixelWindow window_, AovSet aovs_)
 namespace {
 
 /// NaN or infinity: all exponent bits set. A bit test rather than std::isfinite, component by
-/// component without Vec3::operator[]'s branches, so the loops below vectorise: the whole-film
-/// pass after every render was ~0.4% of the time of a whitted1980 render.
+/// component without Vec3::operator[]'s branches, so the loops below vectorise.
 inline bool nonfinite(float x) { return (std::bit_cast<uint32_t>(x) & 0x7f800000u) == 0x7f800000u; }
 
 template <typename V>

@@ -30,7 +30,7 @@ struct AaSettings {
                                       ///< pixel-centre values for tests), the CLI's default is adaptive
     float threshold = 0.1f;           ///< adaptive: split when the corners' display-referred values differ by
                                       ///< more than this (max over channels of max - min); < 0 = always split
-    int depth = 3;                    ///< adaptive: maximum subdivision depth (0..8), default 3 as in the issue; sub-squares of 1/2^depth pixel
+    int depth = 3;                    ///< adaptive: maximum subdivision depth (0..8); sub-squares of 1/2^depth pixel
     int spp = 16;                     ///< stratified: samples per pixel, a square number k*k (1..4096)
     PixelFilter filter = PixelFilter::Box;  ///< stratified: box (1 pixel) or tent (radius 1 pixel)
 };

@@ -43,7 +43,7 @@ CameraModel::CameraModel(const Camera& camera, int width, int height)
 
 inline Ray CameraModel::make_ray(double x, double y) const {
     // Normalized device coordinates in [-1, 1], +y up. One division per ray (the reciprocal of
-    // the length): this runs once per camera sample, next to a cheap Embree miss for background.
+    // the length): this runs once per camera sample.
     const double sx = (x * m_ndc_x - 1.0) * m_half_w;
     const double sy = (1.0 - y * m_ndc_y) * m_half_h;
     Ray r;
@@ -86,10 +86,8 @@ struct PerspectiveRow {
 /// packed double arithmetic (sqrtpd and divpd included: camera.cpp is compiled with
 /// -fno-math-errno, and the lengths are never negative). Packed IEEE operations round exactly as
 /// the scalar ones, so every lane is bit for bit what generate() computes. Baseline SSE2 (2
-/// doubles per instruction) on purpose: an AVX2 clone (4 per instruction, `target_clones`) made
-/// whole renders 6-15 % slower on this machine's Xeon (whitted1980 and Duck, interleaved, CPU
-/// time) although the loop itself is shorter — 256-bit code next to the renderer's SSE code costs
-/// more than it saves here.
+/// doubles per instruction) on purpose: 256-bit code next to the renderer's SSE code costs more
+/// than the shorter loop saves.
 void perspective_block(const PerspectiveRow& c, size_t begin, float* __restrict dir_x, float* __restrict dir_y,
                        float* __restrict dir_z, double* __restrict len_out) {
     for (int i = 0; i < int(kRowBlock); ++i) {

@@ -26,9 +26,8 @@ public:
     /// (width, height) = bottom-right; pixel centres are at +0.5. Direction is unit length.
     Ray generate(double x, double y) const;
     /// A row of rays: rays[i] = generate(x0 + i * dx, y), bit for bit. Perspective rows are
-    /// computed in blocks of packed double arithmetic (AVX2 when the CPU has it), so the divisions
-    /// and square roots of neighbouring rays share instructions (one ray's generate() waits on its
-    /// own: about 9% of an opaque one-thread render's samples).
+    /// computed in blocks of packed double arithmetic, so the divisions and square roots of
+    /// neighbouring rays share instructions.
     void generate_row(double x0, double dx, double y, std::span<Ray> rays) const;
     /// Footprint of one pixel as a ray cone: perspective cameras spread by the angle one pixel
     /// subtends at the image centre (2 tan(yfov/2) / height), orthographic ones have a constant

@@ -9,8 +9,8 @@
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/scene/scene.h"
-#include "renderer/scene/scene_analysis.h"
 #include "shading/material_mapping.h"
+#include "shading/scene_analysis.h"
 
 namespace whitted {
 
@@ -62,7 +62,7 @@ public:
     SurfacePoint surface(const Ray& ray, const Hit& hit, const RayCone& cone = {}) const;
     /// Material inputs at a point (factors x textures x vertex color).
     PbrSample material_inputs(const Material& material, const SurfacePoint& sp) const;
-    /// The seed's coefficients at a point.
+    /// Whitted's (1980) coefficients at a point.
     WhittedCoeffs coefficients(const SurfacePoint& sp) const;
     const Scene& scene() const { return m_scene; }
     const MappingOptions& mapping() const { return m_mapping; }

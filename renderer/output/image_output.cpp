@@ -366,12 +366,12 @@ EncodedImage encode_display(const Film& film, FileKind kind, const OutputSetting
     return image;
 }
 
-/// Removes a temporary file when it goes out of scope, unless released (after the rename).
 /// The temporary file of the write in progress as a plain C string, so that a signal handler can
 /// remove it (remove_partial_output()); one write at a time is tracked (the CLI writes one).
 char g_partial_path[4096];
 std::atomic<bool> g_partial_active{false};
 
+/// Removes a temporary file when it goes out of scope, unless released (after the rename).
 class TempFileGuard {
 public:
     explicit TempFileGuard(fs::path path) : m_path(std::move(path)) {
@@ -444,8 +444,7 @@ void write_atomically(const EncodedImage& image, FileKind kind, const fs::path& 
 
 }  // namespace
 
-/// Async-signal-safe (unlink only): removes the temporary file of a write in progress, so a
-/// process ended by a signal leaves no half-written file. Declared where it is used (main.cpp).
+// Async-signal-safe: unlink only.
 void remove_partial_output() noexcept {
     if (g_partial_active.load()) ::unlink(g_partial_path);
 }

@@ -140,15 +140,15 @@ struct TextureRef {
 
 enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
 
-/// The seed's (Whitted 1980) surface coefficients at one point, all linear RGB.
+/// Whitted's (1980) surface coefficients at one point, all linear RGB.
 /// I = Ia*Ka + sum_i Is_i*fat_i*s_i*(kd (N.L) + ks (N.H)^n) + kr*R + kt*T + emission
 struct WhittedCoeffs {
     Color kd{0.f};                    ///< diffuse reflectance
     Color ka{0.f};                    ///< ambient reflectance (multiplies the ambient light Ia)
     Color ks{0.f};                    ///< specular highlight coefficient (Phong-Blinn)
     float n = 1.f;                    ///< highlight exponent
-    Color kr{0.f};                    ///< mirror reflection weight (the seed's Ks on R)
-    Color kt{0.f};                    ///< transmission weight (the seed's Kt on T)
+    Color kr{0.f};                    ///< mirror reflection weight (Whitted's (1980) Ks on R)
+    Color kt{0.f};                    ///< transmission weight (Whitted's (1980) Kt on T)
     float ior = 1.5f;                 ///< index of refraction of the inside medium
     bool thin = true;                 ///< thin-walled: transmitted rays go straight through
     Color emission{0.f};              ///< emitted radiance added as is
@@ -156,7 +156,7 @@ struct WhittedCoeffs {
 };
 
 /// Which model a material uses: glTF metallic-roughness (mapped per hit point by
-/// shading/material_mapping) or the seed's coefficients given directly (scene files).
+/// shading/material_mapping) or Whitted's (1980) coefficients given directly (scene files).
 enum class MaterialModel : uint8_t { GltfPbr, Classic };
 
 struct Material {
@@ -192,7 +192,7 @@ struct Material {
     TextureRef specular_texture;               ///< A channel
     TextureRef specular_color_texture;         ///< RGB, sRGB-encoded
 
-    // MaterialModel::Classic: the seed's parameters, used as given.
+    // MaterialModel::Classic: Whitted's (1980) coefficients, used as given.
     WhittedCoeffs classic;
     TextureRef classic_color_texture;          ///< Classic: RGB multiplies kd and ka (checker or image)
 };

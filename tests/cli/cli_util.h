@@ -49,7 +49,7 @@ inline Result run(const std::string& args) {
 /// A folder for one test's files, created if needed: <tmp>/<prefix>_<pid>/<name> (per process, so
 /// parallel ctest runs do not share it).
 inline std::filesystem::path scratch_dir(const std::string& prefix, const std::string& name) {
-    std::string folder = prefix;  // appended, not `prefix + "_" + ...` (GCC 12's -Wrestrict false positive)
+    std::string folder = prefix;  // appended, not `prefix + "_" + ...` (a -Wrestrict false positive)
     folder += '_';
     folder += std::to_string(::getpid());
     const std::filesystem::path dir = std::filesystem::temp_directory_path() / folder / name;

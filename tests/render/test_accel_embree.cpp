@@ -2,7 +2,7 @@
 //
 // Per ray: the same closest primitive, or a tie as judged by the double-precision reference
 // (`bvh:precision=double`): both backends' hits lie within 1e-5 relative of the reference t.
-// Anything else is a divergence; its fraction must stay <= 0.1% (the target).
+// Anything else is a divergence; its fraction must stay <= 0.1%.
 // Per image: render with both; pixels whose primitive/instance-ID AOVs agree must match in beauty
 // within 1e-4 relative; pixels whose IDs differ are counted (target <= 0.1% of the image) and
 // must lie on ID boundaries. The same figures are printed for Embree with RTC_SCENE_FLAG_ROBUST.

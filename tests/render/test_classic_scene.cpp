@@ -1,4 +1,4 @@
-// The seed's (Whitted 1980) worked formulas as tests: the reflection direction R = 2(N.L)N - L,
+// Whitted's (1980) formulas as tests: the reflection direction R = 2(N.L)N - L,
 // Snell's law with n1/n2 and total internal reflection, the classic attenuation
 // fat = min(1, 1/(c1 + c2 d + c3 d^2)), and the local model on an analytic sphere under one light
 // at known pixels, through every accelerator backend.
@@ -107,7 +107,7 @@ Scene sphere_scene() {
     sphere.material = add_classic_material(s, kMaterial);
     s.spheres.push_back(sphere);
     Light l = point_light(kLightPos, 1.f);
-    l.attenuation = Attenuation::Classic;  // c = (1, 0, 0): fat = 1, the seed's unattenuated Is
+    l.attenuation = Attenuation::Classic;  // c = (1, 0, 0): fat = 1, Whitted's (1980) unattenuated Is
     l.classic_c = {1.f, 0.f, 0.f};
     s.lights.push_back(l);
     s.cameras.push_back(make_camera(CameraType::Orthographic, {0, 0, 5}, {0, 0, -1}, {0, 1, 0}, kMag));

@@ -1,14 +1,11 @@
 // A transparent object resting on an opaque floor (default.glb's red_panel): a closed, thin-walled
 // transmissive box whose bottom face lies exactly in the floor's plane. A ray entering the box
-// through a wall meets the floor and the box's bottom face at the same t (coincident faces); the
-// accelerator reports either. When it reports the bottom face, the straight-through continuation
-// starts a few ulps below the floor and misses it (docs/numerical-stability.md, "Opaque surfaces
-// under thin transmissive ones"), so the floor inside the box's footprint turned near-black
-// at the pixels where rounding let the bottom face win: a dotted dark line along the foot of the
-// panel, moving between backends. The answer must not depend on which of two coincident faces the
-// accelerator names: the floor seen through the box must look the same as through the same box
-// without its bottom face (an opaque surface covers a transparent one lying on it: OpaqueCovers in
-// renderer/integrator/whitted_integrator.cpp).
+// through a wall meets the floor and the box's bottom face at the same t (coincident faces), and
+// the accelerator may report either; the straight-through continuation from the bottom face starts
+// a few ulps below the floor and misses it (docs/numerical-stability.md, "Opaque surfaces under
+// thin transmissive ones"). The floor seen through the box must look the same as through the same
+// box without its bottom face (an opaque surface covers a transparent one lying on it: the
+// integrator's OpaqueCovers).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -131,7 +128,7 @@ class ContactEdges : public ::testing::TestWithParam<const char*> {};
 
 // The floor inside a transparent box's footprint is seen through the box whichever of the two
 // coincident faces (floor, bottom face) the accelerator reports, as through the box without its
-// bottom face to 1 % (it was ~0.1 of that, the wall's reflection alone, where the bottom face won).
+// bottom face, to 1 %.
 TEST_P(ContactEdges, FloorUnderTransparentBoxIsNotLost) {
     for (const bool box_first : {false, true}) {
         const Outcome o = trace_footprint(GetParam(), box_first);

@@ -11,7 +11,7 @@
 
 #include "importers/scene_loader.h"
 #include "renderer/integrator/render.h"
-#include "renderer/scene/scene_analysis.h"
+#include "shading/scene_analysis.h"
 #include "tests/support/scene_builder.h"
 
 namespace whitted {

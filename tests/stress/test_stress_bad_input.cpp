@@ -1,10 +1,10 @@
-// Stress 6 (issue #7): bad numbers in input. Files: NaN / infinite values are rejected with a
-// located error; denormals are flushed and zero-area triangles kept but reported, each kind with
-// one warning and a count. Scenes built in code (which bypass the importers): NaN / infinite
-// positions, normals and UVs, zero-area and needle triangles, zero-length normals, denormal
-// coordinates, a camera inside geometry, znear 0, a light on the surface; every backend renders
-// them without a NaN or infinite pixel. (The glTF importer's own NaN checks are unit-tested in
-// tests/unit/test_gltf_importer.cpp; they are not repeated here.)
+// Bad numbers in input (docs/numerical-stability.md, section 6). Files: NaN / infinite values are
+// rejected with a located error; denormals are flushed and zero-area triangles kept but reported,
+// each kind with one warning and a count. Scenes built in code (which bypass the importers): NaN /
+// infinite positions, normals and UVs, zero-area and needle triangles, zero-length normals,
+// denormal coordinates, a camera inside geometry, znear 0, a light on the surface; every backend
+// renders them without a NaN or infinite pixel. (The glTF importer's own NaN checks are
+// unit-tested in tests/unit/test_gltf_importer.cpp; they are not repeated here.)
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,6 +1,6 @@
-// Stress 5 (issue #7): deep ray trees. Two parallel mirrors with max depth 1 ... 200: the render
-// terminates, does not overflow the stack (also on TBB worker threads) and the radiance is the
-// geometric series a (1 - r^(D+1)) / (1 - r) the seed's recursion predicts.
+// Deep ray trees (docs/numerical-stability.md, section 5). Two parallel mirrors with max depth
+// 1 ... 200: the render terminates, does not overflow the stack (also on TBB worker threads) and
+// the radiance is the geometric series a (1 - r^(D+1)) / (1 - r) Whitted's recursion predicts.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -85,11 +85,8 @@ TEST(StressDeepTree, MinWeightCutsTheTree) {
     EXPECT_NEAR(double(f.beauty[0].x), 0.1 * (1.0 - std::pow(0.9, 53)) / 0.1, 1e-4);
 }
 
-// Known problem (renderer/integrator/render.cpp, not fixed here): the ray tree recurses on the
-// thread's stack, about 400 bytes per level; the CLI and scene files cap max_depth at 64, but
-// RenderSettings accepts any value and a library caller asking for 30000 levels overflows the
-// stack (measured: 10000 levels render, 30000 crash, on the main thread and on TBB workers).
-// Proposed: Renderer's constructor rejects max_depth above a documented cap (e.g. 1024).
+// The ray tree recurses on the thread's stack (a few hundred bytes per level), so the Renderer
+// refuses a max_depth above kMaxTreeDepth instead of overflowing it.
 TEST(StressDeepTree, RendererRejectsDepthBeyondTheStack) {
     RenderSettings rs;
     rs.width = rs.height = 1;

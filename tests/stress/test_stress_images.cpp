@@ -1,6 +1,7 @@
-// Stress 2 and 4 (issue #7): the bundled scenes rendered scaled (camera and lights too) and
-// translated must match the unscaled double-precision render; every pixel of every bundled scene
-// stays below the bound the local model allows, and none is NaN.
+// Scale invariance and energy (docs/numerical-stability.md, sections 2 and 4): the bundled
+// scenes rendered scaled (camera and lights too) and translated must match the unscaled
+// double-precision render; every pixel of every bundled scene stays below the bound the local
+// model allows, and none is NaN.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -35,7 +36,7 @@ Film render(const Scene& scene, const std::string& accel) {
 /// The stated tolerance holds for any scale and for translations up to 10x the scene's extent
 /// (about 10 units before scaling). Farther out, float hit points, normals and the 4-ulp ray
 /// offsets are coarse against the scenes' thin features (a 0.05 glass shell is 6 float steps thick
-/// at 1e5) and the images degrade: measured in docs/numerical-stability.md, recorded here.
+/// at 1e5) and the images degrade (docs/numerical-stability.md, section 2).
 bool within_tolerance_range(double s, double t) { return t <= 100.0 * s; }
 
 TEST(StressImages, ScaleAndTranslationInvariance) {
@@ -64,11 +65,10 @@ TEST(StressImages, ScaleAndTranslationInvariance) {
 }
 
 // Every in-house backend renders the small bundled scenes exactly as bvh does (brute force is the
-// oracle; all of them share the float watertight triangle test). Regression of the self-hits on
-// whitted1980's large floor near the world origin: with offsets in ulps of max|p| alone, shadow
-// rays found the floor again at t ~ 1e-8 with brute, grid and octree (no per-primitive box test),
-// a speckled patch of ~1.4 % of the pixels; offsets in ulps of the hit triangle's vertices
-// (SurfacePoint::offset_scale, ray_offset.h) remove it. Brute force takes minutes on
+// oracle; all of them share the float watertight triangle test). Guards the offsets in ulps of
+// the hit triangle's vertices (SurfacePoint::offset_scale, ray_offset.h): in ulps of max|p| alone,
+// shadow rays from whitted1980's large floor near the world origin find the floor again with
+// brute, grid and octree (no per-primitive box test). Brute force takes minutes on
 // glass_mirror_room (its boxes) and default.glb: the structures stand in for it there.
 TEST(StressImages, InHouseBackendsAgreeOnSmallBundledScenes) {
     for (const char* name : {"whitted1980.json", "transparent_shadows.json", "glass_mirror_room.json"}) {
@@ -76,7 +76,7 @@ TEST(StressImages, InHouseBackendsAgreeOnSmallBundledScenes) {
         const Scene scene = load_bundled(name);
         auto render_at = [&](const char* accel) {
             RenderSettings rs = settings_for(scene, accel);
-            rs.width = 160;  // enough pixels on the floor near the origin (~1.4 % of them differed)
+            rs.width = 160;  // enough pixels on the floor near the origin
             return Renderer(scene, rs).render();
         };
         const Film reference = render_at("bvh");

@@ -1,6 +1,7 @@
-// Stress 4 (issue #7): grazing angles and refraction. Mirrors (planes, meshes, spheres) hit at
-// incidence angles up to 89.99 degrees; slabs of ior 1.0 (invisible), 1.0001, 1.5 and 2.4; total
-// internal reflection at and around the critical angle; nested and touching dielectrics.
+// Grazing angles and refraction (docs/numerical-stability.md, section 4). Mirrors (planes,
+// meshes, spheres) hit at incidence angles up to 89.99 degrees; slabs of ior 1.0 (invisible),
+// 1.0001, 1.5 and 2.4; total internal reflection at and around the critical angle; nested and
+// touching dielectrics.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -283,11 +284,10 @@ TEST(StressRefraction, SlabsWithAGapActAsOne) {
 }
 
 // Touching dielectrics: two slabs sharing a face (coincident, opposite-facing surfaces) act as one
-// slab of the combined thickness. Without the integrator's contact handling (DielectricContacts,
-// whitted_integrator.cpp) the ray leaving the first slab starts past the shared plane inside the
-// second, never meets its face, and crosses it bent as if it had left into air: 12 % of these
-// pixels differed. Which of the two coincident faces the accelerator reports is arbitrary, so the
-// slabs are also added in the other order.
+// slab of the combined thickness. Without the integrator's contact handling (DielectricContacts)
+// the ray leaving the first slab starts past the shared plane inside the second, never meets its
+// face, and crosses it bent as if it had left into air. Which of the two coincident faces the
+// accelerator reports is arbitrary, so the slabs are also added in the other order.
 TEST(StressRefraction, TouchingSlabsActAsOne) {
     for (const bool swap : {false, true})
         for (const char* accel : {"bvh", "embree"}) {

@@ -1,5 +1,6 @@
-// Stress 1 (issue #7): self-intersection at any scale, and 7: hit-point error against the double
-// reference. Bounded for CI; `whitted bench stability` runs the same probes with more points.
+// Self-intersection at any scale and hit-point error against the double reference
+// (docs/numerical-stability.md, sections 1 and 7). Bounded for CI; `whitted bench stability` runs
+// the same probes with more points.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -104,8 +105,8 @@ TEST(StressSelfIntersection, NoSelfHitsAndNeighboursHitAtAnyScale) {
                 }
 }
 
-// The same probe with the pre-#7 offset: neighbours within its 256-ulp (and, below |p| = 1/32,
-// 1/65536 absolute) offset are skipped, so the test above can fail.
+// The same probe with Wächter & Binder's offset as published: neighbours within its 256-ulp (and,
+// below |p| = 1/32, 1/65536 absolute) offset are skipped, so the test above can fail.
 TEST(StressSelfIntersection, PreviousOffsetSkipsNeighbours) {
     for (double s : {1e-4, 1.0}) {
         SelfIntersectionConfig c;
@@ -138,8 +139,8 @@ SelfIntersectionConfig tilted_quad(const char* accel, double scale, int points) 
 // A large tilted square through the world origin, points down to 1e-4 of its size from the
 // origin: SceneView interpolates the hit point from float world-space vertices far larger than the
 // point, so its error is thousands of ulp(max|p|) (cancellation) and no offset relative to |p|
-// covers it. With the hit point computed in double (the proposed SceneView change, emulated
-// here) the same offset has no self-hits at any scale.
+// covers it. With the exact hit point (emulated here) the same offset has no self-hits at any
+// scale.
 TEST(StressSelfIntersection, TiltedQuadThroughOriginWithDoubleHitPoint) {
     for (const char* accel : {"bvh", "embree"})
         for (double s : kScales) {
@@ -150,8 +151,8 @@ TEST(StressSelfIntersection, TiltedQuadThroughOriginWithDoubleHitPoint) {
         }
 }
 
-// The renderer's own hit point (SceneView computes it in double since the stability suite found
-// the cancellation): the tilted square through the origin has no self-hits and a small error.
+// The renderer's own hit point (SceneView computes it in double): the tilted square through the
+// origin has no self-hits and a small error.
 TEST(StressSelfIntersection, TiltedQuadThroughOriginRendererHitPoint) {
     for (const char* accel : {"bvh", "embree"}) {
         const SelfIntersectionConfig c = tilted_quad(accel, 1.0, 300);
@@ -168,10 +169,10 @@ TEST(StressSelfIntersection, TiltedQuadThroughOriginRendererHitPoint) {
 // through the origin (points down to 1e-4 of its size from the origin), neighbours at
 // kGuaranteedGapUlps offset units. The float watertight triangle test's t error scales with the
 // vertices' coordinates, not with the small |p|: with offsets in ulps of max|p| alone, the
-// backends without a per-primitive box test (brute, grid, octree) found the square again just
-// past the origin (whitted1980's floor, docs/numerical-stability.md); bvh, kdop and Embree did not
-// only because the flat box is entered at negative t. Offsets in ulps of
-// max(max|p|, offset_scale) (the triangle's vertices) avoid it with every backend.
+// backends without a per-primitive box test (brute, grid, octree) find the square again just
+// past the origin (bvh, kdop and Embree do not only because the flat box is entered at negative
+// t). Offsets in ulps of max(max|p|, offset_scale) (the triangle's vertices) avoid it with every
+// backend.
 TEST(StressSelfIntersection, LargeTriangleNearOriginEveryBackend) {
     for (const char* accel : {"brute", "grid", "octree", "kdop", "bvh", "embree"})
         for (double s : kScales) {
@@ -188,8 +189,8 @@ TEST(StressSelfIntersection, LargeTriangleNearOriginEveryBackend) {
         }
 }
 
-// The probe above with the unit of the point alone (the offset before the fix): brute force
-// re-hits the square from points near the origin, so the test above can fail.
+// The probe above with the unit of the point alone: brute force re-hits the square from points
+// near the origin, so the test above can fail.
 TEST(StressSelfIntersection, PointOnlyUnitSelfHitsLargeTriangles) {
     SelfIntersectionConfig c = tilted_quad("brute", 1.0, 200);
     c.offset = [](const Vec3f& p, float, const Vec3f& n) { return offset_ray_origin(p, 0.f, n); };
@@ -197,12 +198,12 @@ TEST(StressSelfIntersection, PointOnlyUnitSelfHitsLargeTriangles) {
     EXPECT_GT(r.self_hits[0] + r.self_hits[1] + r.self_hits[2], 0u);
 }
 
-// Issue #7's number: every neighbour surface 4 ulps away must be hit, with no self-hit. With
-// float traversal no offset does both (numerical-stability.md, section 1); the double-precision
-// path's policy (kDoubleRayOffset: half an ulp, origins 0.5 ... 2.5 units away) does, on the
-// tessellated sphere (flat and smooth normals), the analytic sphere and the large square through
-// the world origin, at every resolvable scale and translation. Collapsed objects (under 16 float
-// steps across) are not surfaces at float precision: there only the float policy is self-hit free.
+// Every neighbour surface 4 ulps away must be hit, with no self-hit. With float traversal no
+// offset does both (docs/numerical-stability.md, section 1); the double-precision path's policy
+// (kDoubleRayOffset: half an ulp, origins 0.5 ... 2.5 units away) does, on the tessellated sphere
+// (flat and smooth normals), the analytic sphere and the large square through the world origin,
+// at every resolvable scale and translation. Collapsed objects (under 16 float steps across) are
+// not surfaces at float precision: there only the float policy is self-hit free.
 TEST(StressSelfIntersection, DoublePathHitsNeighboursFourUlpsAway) {
     for (int surface = 0; surface < 4; ++surface)
         for (double t : kTranslations)
@@ -267,8 +268,8 @@ TEST(StressSelfIntersection, FloatPathNeedsItsOwnPolicy) {
 
 // In the collapsed case s = 1e-4 at t = 1e3 the 12-ulp gap is ~9 times the object's size: the
 // inner neighbour would have a negative scale (a mirrored sphere outside A, crossed by outward
-// shadow rays as well as B: transparent-shadow "double counts" that were the probe's, not the
-// accelerator's). The probe leaves it out; no shadow ray then sees two crossings.
+// shadow rays as well as B, so shadow rays would count two crossings that are the probe's, not
+// the accelerator's). The probe leaves it out.
 TEST(StressSelfIntersection, CollapsedCasesHaveNoInnerNeighbour) {
     for (const char* accel : {"bvh", "embree"})
         for (bool analytic : {false, true}) {
@@ -291,8 +292,8 @@ TEST(StressSelfIntersection, CollapsedCasesHaveNoInnerNeighbour) {
     EXPECT_TRUE(probe_self_intersection(resolvable_case).inner_neighbour);
 }
 
-// Stress 7: the integrator's float hit point (SceneView, after the Embree or in-house float hit)
-// against the exact point of the double-precision reference; error in ulp(max|p|).
+// Hit-point error: the integrator's float hit point (SceneView, after the Embree or in-house
+// float hit) against the exact point of the double-precision reference; error in ulp(max|p|).
 TEST(StressHitError, FloatHitPointsWithinFewUlps) {
     for (const char* accel : {"bvh", "embree"})
         for (bool sphere : {false, true})
@@ -305,7 +306,7 @@ TEST(StressHitError, FloatHitPointsWithinFewUlps) {
                     EXPECT_GT(r.both_hit, 500u) << what;
                     EXPECT_LE(r.miss_mismatch, r.rays / 100) << what;  // grazing rays at the silhouette
                     const Distribution d = distribution(r.ulp_error);
-                    // Measured (docs/numerical-stability.md): median <= 1.9, max <= 20 ulps for
+                    // Bounds from docs/numerical-stability.md: median <= 1.9, max <= 20 ulps for
                     // triangles (float barycentrics move the point along the surface), max <= 10
                     // for spheres (t error along the ray before the re-projection).
                     EXPECT_LE(d.median, 2.5) << what;

@@ -1,6 +1,7 @@
-// Stress 3 (issue #7): watertightness. Rays from inside closed meshes aimed at vertices, edge
-// midpoints and random points must all hit: 0 leaks for every in-house backend (Woop et al. 2013
-// with the double fallback); Embree's count is recorded, with and without RTC_SCENE_FLAG_ROBUST.
+// Watertightness (docs/numerical-stability.md, section 3). Rays from inside closed meshes aimed
+// at vertices, edge midpoints and random points must all hit: 0 leaks for every in-house backend
+// (Woop et al. 2013 with the double fallback); Embree's count is recorded, with and without
+// RTC_SCENE_FLAG_ROBUST.
 // `whitted bench stability` runs 10M rays per backend and mesh.
 #include <gtest/gtest.h>
 

@@ -8,7 +8,7 @@
 
 namespace whitted::test {
 
-/// Adds a Classic (seed-parameter) material and returns its index.
+/// Adds a Classic material (Whitted's (1980) coefficients) and returns its index.
 inline uint32_t add_classic_material(Scene& s, const WhittedCoeffs& c, const std::string& name = "classic") {
     Material m;
     m.name = name;

@@ -480,7 +480,7 @@ TEST(AccelDegenerate, AllTrianglesAtOnePoint) {
 /// A hit at a tiny t from an origin far (relatively) from the world origin, on a flat floor whose
 /// box has zero thickness, with tfar exactly at the hit: the triangle's t carries an error of
 /// order eps * |p - o| / |d|, far more than eps * t, and no culling test may drop that box
-/// (found by the clang ASan build on the default scene; SlabRay::cull_slack).
+/// (SlabRay::cull_slack).
 TEST(AccelCrossCheck, TinyTHitWithTfarExactlyAtTheHit) {
     Scene s;
     Mesh floor;

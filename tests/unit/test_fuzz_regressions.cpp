@@ -192,7 +192,7 @@ TEST(HostileInput, InstanceCountsAreBoundedByTheMemoryLimit) {
     for (int i = 0; i < 200; ++i) {
         prims += std::string(i ? "," : "") + R"({"attributes":{"POSITION":0}})";
         nodes += std::string(i ? "," : "") + R"({"mesh":0})";
-        if (i) roots += ',';  // appended, not `"," + to_string(i)` (GCC 12's -Wrestrict false positive)
+        if (i) roots += ',';  // appended, not `"," + to_string(i)` (a -Wrestrict false positive)
         roots += std::to_string(i);
     }
     const std::string gltf = "{" + kAsset + R"(,"buffers":[{"uri":")" + data_uri(b.data) +

@@ -526,7 +526,7 @@ TEST(GltfImporter, MetalRoughSpheresLoadsQuickly) {
     const Scene s = load_scene(asset("MetalRoughSpheresNoTextures/glTF-Binary/MetalRoughSpheresNoTextures.glb"));
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     EXPECT_EQ(s.instanced_triangle_count(), 1040409u);
-    EXPECT_LT(seconds, 3.0);  // about 0.02 s on the reference machine: a quadratic step would show
+    EXPECT_LT(seconds, 3.0);  // generous for a linear import; a quadratic step would show
     // The 98 spheres share one geometry (accessors 0, 26, 52) with 98 materials.
     size_t spheres = 0;
     for (const Mesh& m : s.meshes) spheres += m.positions.size() == 5374;

@@ -241,7 +241,7 @@ TEST(SceneFile, MaterialCoefficients) {
     expect_vec(m.kd, Color(0.05f));
     expect_vec(m.ka, Color(0.05f));  // ka defaults to kd
     expect_vec(m.ks, Color(0.8f, 0.7f, 0.6f));
-    expect_vec(m.kr, Color(0.8f, 0.7f, 0.6f));  // the seed's Ks weights both
+    expect_vec(m.kr, Color(0.8f, 0.7f, 0.6f));  // Whitted's single ks weights both
 
     const WhittedCoeffs& sp = material_named(s, "split").classic;
     expect_vec(sp.kd, Color(0.5f, 0.4f, 0.3f));  // color = kd

@@ -1,29 +1,16 @@
 // Wide BVH over one mesh's triangles (float): the binary SAH tree of bvh_tree.h collapsed into
 // nodes of N = 4 or 8 children whose boxes are tested together with SIMD, and leaves of triangles
-// stored four at a time (structure of arrays) and tested together. The same tree (WideTree) serves
-// `bvh`'s top level over instances (WideInstanceTree, at the end), whose traversal inlines the
-// meshes' and shares the per-ray constants (WideRay) with the identity-transform meshes. Models: Wald, Benthin &
-// Boulos 2008 ("Getting rid of packets", the multi-branching BVH), Embree's BVH4/BVH8 with
-// Triangle4 leaves, bvh v2's mini-tree collapse and tinybvh's BVH8_CPU.
+// stored and tested four at a time (structure of arrays). The same WideTree serves `bvh`'s top
+// level over instances (WideInstanceTree, at the end), which hands its per-ray constants (WideRay)
+// to the identity-transform meshes. Models: Wald, Benthin & Boulos 2008 (multi-branching BVH),
+// Embree's BVH4/BVH8 with Triangle4 leaves, bvh v2's collapse and tinybvh's BVH8_CPU.
 //
-// Results are those of the binary `bvh:width=2` (up to ties, below):
-//   - node test: the conservative slab test of geometry.h (Ize 2013) evaluated on N lanes, with
-//     the same near/far plane choice by the direction's sign bit, the same NaN rule, the same
-//     exit enlargement (folded into the far plane's reciprocal) and culling slack
-//     (tmax * kRayTmaxScale + SlabRay::t_slack): like the scalar test it never culls a box that
-//     holds an accepted hit;
-//   - leaf test: the watertight test of Woop, Benthin & Wald 2013 (intersect_triangle) with every
-//     operation in the same order on four lanes, so t, u, v are bit-identical; lanes whose edge
-//     function comes out exactly 0 are recomputed in double as the scalar test does. Hits are
-//     reported to the query lane by lane in slot order, each against the query's current tmax,
-//     i.e. exactly as the scalar leaf loop would report them.
-// Only the order in which leaves are visited differs (nearest child first; and the leaves
-// themselves, as the wide build counts triangles in packets), which can change which of two hits
-// at exactly the same t wins: a tie the cross-check accepts.
-//
-// Node tests of an 8-wide tree run as one AVX instruction per operation where the CPU has AVX2
-// (runtime dispatch, simd.h), else as two SSE halves (slow: `bvh` then defaults to 4-wide trees,
-// which always use SSE).
+// Results are those of the binary `bvh:width=2`: the node test is the conservative slab test of
+// geometry.h (Ize 2013) on N lanes, the leaf test the watertight test (Woop, Benthin & Wald 2013)
+// with every operation in the same order on four lanes, and hits are reported in the scalar leaf
+// loop's order. Only the order in which leaves are visited differs, which can change which of two
+// hits at exactly the same t wins. 8-wide node tests run in AVX2 where the CPU has it (runtime
+// dispatch, simd.h), else as two SSE halves. Details: docs/accelerators.md, "Wide BVH".
 #pragma once
 
 #include <algorithm>
@@ -385,7 +372,7 @@ public:
 
 private:
     // The two compilations of the traversal; everything they call is inlined into them
-    // (flatten: the ray set-up and the query's report() too, which is measurably faster).
+    // (flatten: the ray set-up and the query's report() too).
     template <class Query>
     WHITTED_FLATTEN bool traverse_baseline(const Vec3f& org, const Vec3f& dir, float tnear, Query& q) const {
         const WideRay<N> r(org, dir, tnear);

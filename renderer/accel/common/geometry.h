@@ -58,17 +58,17 @@ struct WatertightRay {
     }
 };
 
-/// Tests the triangle (p0, p1, p2) against the ray; on a hit with tnear < t <= tfar (Embree's
-/// interval) writes t and the barycentrics u (of p1) and v (of p2). Edge functions that come out
-/// exactly 0 in float are recomputed in double, as the paper prescribes.
-/// Component k of v by address: Vec3's operator[] branches, which costs a third of the triangle
-/// test when k is only known at run time (the permutation below).
+/// Component k of v by address: Vec3's operator[] branches, which is slow when k is only known
+/// at run time (the permutation below).
 template <typename T>
 inline T component(const Vec3<T>& v, int k) {
     static_assert(sizeof(Vec3<T>) == 3 * sizeof(T) && std::is_standard_layout_v<Vec3<T>>);
     return (&v.x)[k];
 }
 
+/// Tests the triangle (p0, p1, p2) against the ray; on a hit with tnear < t <= tfar (Embree's
+/// interval) writes t and the barycentrics u (of p1) and v (of p2). Edge functions that come out
+/// exactly 0 in float are recomputed in double, as the paper prescribes.
 template <typename T>
 inline bool intersect_triangle(const WatertightRay<T>& r, const Vec3<T>& p0, const Vec3<T>& p1, const Vec3<T>& p2,
                                T tnear, T tfar, T& t_out, T& u_out, T& v_out) {
@@ -161,8 +161,7 @@ constexpr T kRayTmaxScale = T(1) + T(4) * rounding_gamma<T>(8);
 /// lies in the closed slab). The exit distance is enlarged by 1 + 2 gamma(3), so rounding can
 /// never cull a box the ray touches.
 /// Always inlined, axes written out: it is the inner loop of every binary tree (the two-level
-/// top level over instances included), where an out-of-line call per node cost a fifth of the
-/// `bvh` backend's time on multi-instance scenes. Same operations, same results.
+/// top level over instances included).
 template <typename T>
 WHITTED_ALWAYS_INLINE T slab_entry(const SlabRay<T>& r, const Vec3<T>& lo, const Vec3<T>& hi, T tmin, T tmax) {
     tmax = tmax * kRayTmaxScale<T> + r.t_slack;
@@ -190,7 +189,7 @@ WHITTED_ALWAYS_INLINE T volume_entry(const SlabRay<T>& r, const AabbVolume<T>& v
     return slab_entry(r, v.lo, v.hi, tmin, tmax);
 }
 
-/// Bounding sphere volume (the seed's first bounding volume), radius enlarged at build time so
+/// Bounding sphere volume (Whitted's (1980) bounding volume), radius enlarged at build time so
 /// that the float test stays conservative.
 template <typename T>
 struct SphereVolume {

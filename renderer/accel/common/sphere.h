@@ -1,7 +1,7 @@
 // Ray/sphere intersection shared by every backend (the in-house ones and Embree's user geometry),
 // templated on the scalar type: float for the fast paths, double for the reference.
 //
-// The seed's quadratic |o + t d - c|^2 = r^2, i.e. a t^2 + 2 b t + c0 = 0 with f = o - c,
+// The quadratic |o + t d - c|^2 = r^2, i.e. a t^2 + 2 b t + c0 = 0 with f = o - c,
 // a = d.d, b = f.d, c0 = f.f - r^2, solved in the numerically stable form of Haines, Günther &
 // Akenine-Möller, "Precision Improvements for Ray/Sphere Intersection" (Ray Tracing Gems, 2019,
 // ch. 7):

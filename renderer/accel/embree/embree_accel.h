@@ -15,7 +15,7 @@ struct EmbreeConfig {
     int threads = 0;       ///< build threads, 0 = all
     int packet_width = 4;  ///< batch closest-hit queries: rays per rtcIntersect4/8/16 packet, 1 = rtcIntersect1 each
     bool compact = false;  ///< RTC_SCENE_FLAG_COMPACT: leaves index the vertices instead of copying them
-                           ///< (-28 MB on a 1M-triangle mesh, 3-8% slower camera rays; docs/performance.md)
+                           ///< (less memory, slower camera rays; docs/performance.md)
 };
 
 /// Ceiling on the bytes all Embree devices may hold at once (enforced by the device memory

@@ -12,7 +12,7 @@ namespace whitted {
 /// Settings of the `octree` backend. A node is subdivided while it holds more than
 /// `max_leaf_size` triangles, unless one of the limits below stops it.
 struct OctreeConfig {
-    uint32_t max_leaf_size = 1;      ///< "more than one object": subdivide (seed 2.2)
+    uint32_t max_leaf_size = 1;      ///< subdivide every node holding more than one triangle
     int max_depth = 12;              ///< depth limit (the root is depth 0); hard cap 20
     float min_extent = 1e-5f;        ///< no node smaller than this fraction of the root's extent
     int max_stalled_levels = 0;      ///< subdivisions allowed in a row where a child keeps every

@@ -1,6 +1,6 @@
 // Scene analysis at load: per-material features, their OR over the scene, and which lights can
 // reach which objects (range window, spot cone). See scene_analysis.h for the contracts.
-#include "renderer/scene/scene_analysis.h"
+#include "shading/scene_analysis.h"
 
 #include <algorithm>
 #include <cmath>
@@ -26,7 +26,7 @@ MaterialFeatures material_features(const Material& m, const MappingOptions& mapp
     f.constant = map_material_constant(m, mapping);
     f.constant_alpha = std::clamp(m.base_color.w, 0.f, 1.f);
     if (m.model == MaterialModel::Classic) {
-        // The seed's coefficients; a colour texture or vertex colors only tint kd and ka.
+        // Whitted's (1980) coefficients; a colour texture or vertex colors only tint kd and ka.
         const WhittedCoeffs& c = m.classic;
         f.diffuse = !is_black(c.kd);
         f.highlight = !is_black(c.ks);
