@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "renderer/scene/scene_analysis.h"
+#include "shading/scene_analysis.h"
 
 namespace whitted {
 
