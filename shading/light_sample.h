@@ -13,7 +13,7 @@ struct LightSample {
     Color intensity{0.f};    ///< Is * fat * spot: what reaches the point before shadowing
 };
 
-/// Distance attenuation `fat` of the seed: inverse square with glTF's smooth range window
+/// Distance attenuation `fat`: inverse square with glTF's smooth range window
 /// (KHR_lights_punctual recommendation), the classic min(1, 1/(c1 + c2 d + c3 d^2)), or none.
 inline float light_attenuation(const Light& light, float d) {
     switch (light.attenuation) {
