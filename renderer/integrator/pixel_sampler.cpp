@@ -70,7 +70,8 @@ struct AdaptiveScratch {
 
 }  // namespace
 
-/// The old Frame: everything one render shares between its tiles.
+/// Everything one render shares between its tiles: the camera, the integrator, the film, the
+/// corner lattice and the tile-border edge points.
 class PixelSampler::Impl {
 public:
     Impl(const CameraModel& camera, const WhittedIntegrator& integrator, Film& film, const AaSettings& aa,

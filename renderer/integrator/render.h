@@ -1,8 +1,7 @@
-// Renderer: builds the accelerator for a scene once and renders it tile by tile over TBB.
-// The image is bit-identical whatever the thread count or tile size: every primary sample's
-// radiance is a pure function of its image position, each pixel is reduced from its samples in a
-// fixed order, and there are no float reductions across threads. Samples shared between pixels
-// (corner lattice, adaptive edge points) are traced exactly once (docs/antialiasing.md).
+// Renderer: builds the accelerator for a scene once and renders it tile by tile on worker threads
+// (renderer/core/parallel.h) through the pixel layer (pixel_sampler.h). The image is
+// bit-identical whatever the thread count or tile size: every sample's radiance is a pure
+// function of its image position, and each pixel is reduced from its samples in a fixed order.
 #pragma once
 
 #include <memory>
