@@ -125,22 +125,18 @@ void extract_objects(const Scene& scene, const std::vector<uint8_t>& keep, Scene
         sub.instances.push_back(si);
         inst.push_back(i);
     }
-    for (size_t i = 0; i < scene.spheres.size(); ++i) {
-        const uint32_t g = scene.sphere_geom_id(i);
-        if (!keep[object_index(scene, g, kInvalidId)]) continue;
-        Sphere s = scene.spheres[i];
-        s.material = 0;
-        sub.spheres.push_back(s);
-        geom.push_back(g);
-    }
-    for (size_t i = 0; i < scene.planes.size(); ++i) {
-        const uint32_t g = scene.plane_geom_id(i);
-        if (!keep[object_index(scene, g, kInvalidId)]) continue;
-        Plane p = scene.planes[i];
-        p.material = 0;
-        sub.planes.push_back(p);
-        geom.push_back(g);
-    }
+    // Analytic objects (spheres, planes: geometry ids after the meshes), with the one material.
+    auto extract = [&](const auto& from, auto& to, uint32_t first_geom) {
+        for (size_t i = 0; i < from.size(); ++i) {
+            const uint32_t g = first_geom + uint32_t(i);
+            if (!keep[object_index(scene, g, kInvalidId)]) continue;
+            to.push_back(from[i]);
+            to.back().material = 0;
+            geom.push_back(g);
+        }
+    };
+    extract(scene.spheres, sub.spheres, scene.sphere_geom_id(0));
+    extract(scene.planes, sub.planes, scene.plane_geom_id(0));
 }
 
 }  // namespace
