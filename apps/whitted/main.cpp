@@ -17,25 +17,14 @@
 
 #include <unistd.h>
 
-#include "apps/whitted/command.h"
+#include "benchmarks/bench_commands.h"
 #include "importers/scene_loader.h"
 #include "importers/scene_report.h"
-#include "renderer/accel/embree/embree_accel.h"
+#include "renderer/accel/accelerator.h"
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
 #include "renderer/integrator/render.h"
 #include "renderer/output/image_output.h"
-
-// Benchmark modules (one declaration each).
-namespace whitted::app {
-Command register_bench_aa(CLI::App& bench);  ///< `whitted bench aa` (apps/whitted/bench_aa.cpp)
-Command register_bench_accel(CLI::App& bench);  ///< `whitted bench accel` (apps/whitted/bench_accel.cpp)
-Command register_bench_skip(CLI::App& bench);  ///< `whitted bench skip` (apps/whitted/bench_skip.cpp)
-Command register_bench_stability(CLI::App& bench);  ///< `whitted bench stability` (apps/whitted/bench_stability.cpp)
-}  // namespace whitted::app
-using whitted::app::register_bench_aa;
-using whitted::app::register_bench_accel;
-using whitted::app::register_bench_skip;
 
 namespace {
 
@@ -177,7 +166,7 @@ int run_render(RenderOptions o, const std::string& cmdline, Given&& given) {
     io.scene_index = o.scene;
     io.max_memory = size_t(o.max_memory_gb * double(size_t(1) << 30));
     io.allow_outside_uris = o.allow_outside_uris;
-    set_embree_memory_limit(io.max_memory);
+    set_accelerator_memory_limit(io.max_memory);
     Scene scene = load_scene(o.input, io);
     const double load_s = seconds_since(t_load);
     for (const std::string& w : scene.warnings) log_warning("{}: {}", o.input, w);
@@ -396,11 +385,11 @@ int main(int argc, char** argv) {
     CLI::App* bench = app.add_subcommand("bench", "Benchmarks: print figures, write CSV and plots");
     bench->require_subcommand(1);
     std::vector<app::Command> commands;
-    // Each benchmark module registers itself here (one line each):
-    commands.push_back(register_bench_aa(*bench));
-    commands.push_back(register_bench_accel(*bench));
-    commands.push_back(register_bench_skip(*bench));
-    commands.push_back(whitted::app::register_bench_stability(*bench));
+    // Each benchmark module registers itself here (one line each; benchmarks/bench_commands.h):
+    commands.push_back(app::register_bench_aa(*bench));
+    commands.push_back(app::register_bench_accel(*bench));
+    commands.push_back(app::register_bench_skip(*bench));
+    commands.push_back(app::register_bench_stability(*bench));
 
     // Global options (--log-level) may also follow the subcommand.
     render->fallthrough();

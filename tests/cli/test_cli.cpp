@@ -1,8 +1,8 @@
 // The `whitted` program end to end: exit codes, one-line errors, outputs written.
 #include <gtest/gtest.h>
 
-#include "cli_image.h"
-#include "cli_util.h"
+#include "tests/support/cli_image.h"
+#include "tests/support/cli_util.h"
 
 #include <sys/wait.h>
 #include <unistd.h>

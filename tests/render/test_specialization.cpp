@@ -12,12 +12,10 @@
 #include "importers/scene_loader.h"
 #include "renderer/integrator/render.h"
 #include "renderer/scene/scene_analysis.h"
-#include "tests/support/scene_builder.h"
+#include "renderer/scene/scene_builder.h"
 
 namespace whitted {
 namespace {
-
-using namespace whitted::test;
 
 const std::string kAssets = WHITTED_ASSETS_DIR;
 
