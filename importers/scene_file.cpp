@@ -25,6 +25,7 @@
 #include <fmt/format.h>
 
 #include "importers/image_decode.h"
+#include "importers/mesh_normals.h"
 #include "importers/mesh_numbers.h"
 #include "importers/scene_defaults.h"
 #include "importers/scene_file_geometry.h"

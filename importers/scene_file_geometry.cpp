@@ -1,4 +1,4 @@
-// Box, rectangle and normal generation for the scene file.
+// Box and rectangle generation for the scene file.
 
 #include "importers/scene_file_geometry.h"
 
@@ -54,20 +54,6 @@ Vec3d default_u_axis(const Vec3d& n) {
     for (int k = 1; k < 3; ++k)
         if (std::fabs(n[k]) < std::fabs(n[best])) best = k;
     return normalize(axes[best] - n * dot(n, axes[best]));
-}
-
-std::vector<Vec3f> smooth_normals(const Mesh& mesh) {
-    std::vector<Vec3f> acc(mesh.positions.size(), Vec3f(0.f));
-    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-        const uint32_t a = mesh.indices[t], b = mesh.indices[t + 1], c = mesh.indices[t + 2];
-        const Vec3f fn = cross(mesh.positions[b] - mesh.positions[a], mesh.positions[c] - mesh.positions[a]);
-        acc[a] += fn, acc[b] += fn, acc[c] += fn;
-    }
-    for (Vec3f& n : acc) {
-        n = normalize(n);
-        if (!(length(n) > 0.5f)) n = {0.f, 0.f, 1.f};
-    }
-    return acc;
 }
 
 void flip_winding(Mesh& mesh) {

@@ -1,8 +1,6 @@
 // Geometry the scene file generates: boxes, rectangles, inline meshes (private to importers/).
 #pragma once
 
-#include <vector>
-
 #include "renderer/scene/scene.h"
 
 namespace whitted {
@@ -20,11 +18,6 @@ Mesh make_rectangle_mesh(const Vec3d& center, const Vec3d& normal, const Vec3d& 
 /// The default u_axis of a plane: the coordinate axis least aligned with `normal` (x, then y,
 /// then z on ties) made perpendicular to it; unit length. `normal` must be unit.
 Vec3d default_u_axis(const Vec3d& normal);
-
-/// Area-weighted smooth vertex normals: the sum of the (unnormalized) face normals of every
-/// triangle using the vertex, normalized; +Z where the sum vanishes. Shared by the glTF importer
-/// (missing NORMAL) and scene-file meshes.
-std::vector<Vec3f> smooth_normals(const Mesh& mesh);
 
 /// Swaps two indices of every triangle (for transforms with a negative determinant).
 void flip_winding(Mesh& mesh);

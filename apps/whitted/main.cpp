@@ -6,36 +6,26 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 #include <sstream>
 
 #include <unistd.h>
 
-#include "apps/whitted/command.h"
+#include "benchmarks/bench_commands.h"
 #include "importers/scene_loader.h"
 #include "importers/scene_report.h"
-#include "renderer/accel/embree/embree_accel.h"
+#include "renderer/accel/accelerator.h"
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
 #include "renderer/integrator/render.h"
 #include "renderer/output/image_output.h"
-
-// Benchmark modules (one declaration each).
-namespace whitted::app {
-Command register_bench_aa(CLI::App& bench);  ///< `whitted bench aa` (apps/whitted/bench_aa.cpp)
-Command register_bench_accel(CLI::App& bench);  ///< `whitted bench accel` (apps/whitted/bench_accel.cpp)
-Command register_bench_skip(CLI::App& bench);  ///< `whitted bench skip` (apps/whitted/bench_skip.cpp)
-Command register_bench_stability(CLI::App& bench);  ///< `whitted bench stability` (apps/whitted/bench_stability.cpp)
-}  // namespace whitted::app
-using whitted::app::register_bench_aa;
-using whitted::app::register_bench_accel;
-using whitted::app::register_bench_skip;
 
 namespace {
 
@@ -114,20 +104,32 @@ std::string command_line(int argc, char** argv) {
     return s;
 }
 
-struct RenderOptions {
-    std::string input, output = "whitted.png";
-    int width = 0, height = 0, camera = 0, scene = -1, max_depth = 5, tile_size = 32, threads = 0, bits = 0;
-    std::string background = "0", ambient = "0.05", crop, accel = "embree", ocio_config, display, view = "Standard";
-    std::string precision, bv;  ///< in-house BVH options given as flags (appended to the --accel spec)
-    std::vector<std::string> aovs;
-    std::string aa = "adaptive", filter = "box";
-    float aa_threshold = AaSettings{}.threshold;
-    int aa_depth = AaSettings{}.depth, spp = AaSettings{}.spp;
-    float exposure = 0.f, mirror_cutoff = 0.3f, min_weight = 1.f / 255.f;
-    bool fresnel = false, refract_thin = false, robust = true, no_progress = false, exr_float = false;
-    bool no_specialize = false;
-    double max_memory_gb = 8.0;
-    bool allow_outside_uris = false;
+/// Shown as a flag's default: "0.05" for a gray, "r,g,b" otherwise.
+std::string color_text(const Color& c) {
+    return c.x == c.y && c.y == c.z ? fmt::format("{}", c.x) : fmt::format("{},{},{}", c.x, c.y, c.z);
+}
+
+/// The library's RenderSettings with the command line's defaults: adaptive anti-aliasing, the
+/// adaptive tree depth at 1/255 and the progress bar (the library's are one centre ray per pixel,
+/// the depth limit only and no bar).
+RenderSettings cli_render_settings() {
+    RenderSettings rs;
+    rs.aa.mode = AaMode::Adaptive;
+    rs.integrator.min_weight = 1.f / 255.f;
+    rs.progress = true;
+    return rs;
+}
+
+/// What `whitted render` collects: the library's settings, which the flags set directly, and the
+/// few flags that are only other spellings of them.
+struct RenderCommand {
+    std::string input;                          ///< scene file
+    std::string output = "whitted.png";         ///< image file; the extension picks the format
+    ImportOptions import;                       ///< glTF scene index, outside URIs
+    RenderSettings render = cli_render_settings();
+    OutputSettings out;                         ///< OCIO config, display and view, bits, EXR half
+    std::string precision, bv;                  ///< in-house BVH options appended to the --accel spec
+    double max_memory_gb = 8.0;                 ///< ImportOptions::max_memory and the accelerators', in GiB
 };
 
 /// `--precision` and `--bv` are shorthands for the accelerator spec's options of the same names
@@ -142,87 +144,32 @@ std::string with_spec_options(std::string spec, std::initializer_list<std::pair<
     return spec;
 }
 
-/// Scene-file render settings fill every option the command line did not give (`given(flag)`);
-/// flags always win. A relative output path is taken relative to the scene file (as pbrt does).
-template <class Given>
-void apply_scene_settings(RenderOptions& o, const SceneRenderSettings& s, const std::string& scene_path,
-                          Given&& given) {
-    auto color_text = [](const Color& c) { return fmt::format("{},{},{}", c.x, c.y, c.z); };
-    if (s.width && !given("--width")) o.width = *s.width;
-    if (s.height && !given("--height")) o.height = *s.height;
-    if (s.camera && !given("--camera")) o.camera = *s.camera;
-    if (s.aa && !given("--aa")) o.aa = *s.aa;
-    if (s.aa_threshold && !given("--aa-threshold")) o.aa_threshold = *s.aa_threshold;
-    if (s.aa_depth && !given("--aa-depth")) o.aa_depth = *s.aa_depth;
-    if (s.spp && !given("--spp")) o.spp = *s.spp;
-    if (s.max_depth && !given("--max-depth")) o.max_depth = *s.max_depth;
-    if (s.min_weight && !given("--min-weight")) o.min_weight = *s.min_weight;
-    if (s.background && !given("--background")) o.background = color_text(*s.background);
-    if (s.ambient && !given("--ambient")) o.ambient = color_text(*s.ambient);
-    if (s.exposure && !given("--exposure")) o.exposure = *s.exposure;
-    if (s.fresnel && !given("--fresnel")) o.fresnel = *s.fresnel;
-    if (s.view && !given("--view")) o.view = *s.view;
-    if (s.display && !given("--display")) o.display = *s.display;
-    if (s.output && !given("--output")) {
-        std::filesystem::path out(*s.output);
-        o.output = out.is_absolute() ? out.string() : (std::filesystem::path(scene_path).parent_path() / out).string();
-    }
-}
-
-template <class Given>
-int run_render(RenderOptions o, const std::string& cmdline, Given&& given) {
+int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& given) {
     install_interrupt_handlers();
     const auto t_load = Clock::now();
-    ImportOptions io;
-    io.scene_index = o.scene;
-    io.max_memory = size_t(o.max_memory_gb * double(size_t(1) << 30));
-    io.allow_outside_uris = o.allow_outside_uris;
-    set_embree_memory_limit(io.max_memory);
-    Scene scene = load_scene(o.input, io);
+    c.import.max_memory = size_t(c.max_memory_gb * double(size_t(1) << 30));
+    set_accelerator_memory_limit(c.import.max_memory);
+    Scene scene = load_scene(c.input, c.import);
     const double load_s = seconds_since(t_load);
-    for (const std::string& w : scene.warnings) log_warning("{}: {}", o.input, w);
-    apply_scene_settings(o, scene.settings, o.input, given);
-    if (!(o.min_weight >= 0.f && o.min_weight <= 1.f))
-        throw Error(fmt::format("min_weight {} is out of range (expected 0 to 1)", o.min_weight));
+    for (const std::string& w : scene.warnings) log_warning("{}: {}", c.input, w);
 
-    RenderSettings rs;
-    rs.width = o.width;
-    rs.height = o.height;
-    rs.camera = o.camera;
-    rs.integrator.max_depth = o.max_depth;
-    rs.integrator.background = parse_color(o.background, "--background");
-    rs.integrator.ambient = parse_color(o.ambient, "--ambient");
-    rs.integrator.fresnel = o.fresnel;
-    rs.integrator.min_weight = o.min_weight;
-    rs.integrator.specialize = !o.no_specialize;
-    rs.mapping.refract_thin = o.refract_thin;
-    rs.mapping.mirror_roughness_cutoff = o.mirror_cutoff;
-    rs.exposure = std::exp2(o.exposure);
-    rs.tile_size = o.tile_size;
-    rs.threads = o.threads;
-    if (!o.crop.empty()) rs.crop = parse_crop(o.crop);
-    rs.aovs = parse_aovs(o.aovs);
-    rs.aa.mode = parse_aa_mode(o.aa);
-    rs.aa.threshold = o.aa_threshold;
-    rs.aa.depth = o.aa_depth;
-    rs.aa.spp = o.spp;
-    rs.aa.filter = parse_pixel_filter(o.filter);
-    rs.accel = with_spec_options(o.accel, {{"precision", o.precision}, {"bv", o.bv}});
-    rs.robust = o.robust;
-    rs.progress = !o.no_progress;
+    // The scene file's settings fill what the flags did not set.
+    RenderSettings& rs = c.render;
+    OutputSettings& os = c.out;
+    apply_scene_settings(scene.settings, rs, given);
+    apply_scene_output_settings(scene.settings, c.input, c.output, os, given);
+    if (!(rs.integrator.min_weight >= 0.f && rs.integrator.min_weight <= 1.f))
+        throw Error(fmt::format("min_weight {} is out of range (expected 0 to 1)", rs.integrator.min_weight));
+    rs.accel = with_spec_options(rs.accel, {{"precision", c.precision}, {"bv", c.bv}});
 
-    // Resolve the output and color pipeline before the (long) render so bad flags fail fast.
-    OutputSettings os;
-    os.color = ColorSettings{o.ocio_config, o.display, o.view};
-    os.bits = o.bits;
-    os.exr_half = !o.exr_float;
+    // Resolve the color pipeline before the (long) render so bad flags fail fast.
     { DisplayTransform check(os.color); }
 
     Renderer renderer(scene, rs);
     const ImageSize size = renderer.image_size();
-    log_info("{}: {} triangles in {} instances, {} lights, camera {}/{}{}, {}x{}", o.input,
-             scene.instanced_triangle_count(), scene.instances.size(), scene.lights.size(), o.camera,
-             scene.cameras.size(), scene.cameras[size_t(o.camera)].is_default ? " (default)" : "", size.width,
+    log_info("{}: {} triangles in {} instances, {} lights, camera {}/{}{}, {}x{}", c.input,
+             scene.instanced_triangle_count(), scene.instances.size(), scene.lights.size(), rs.camera,
+             scene.cameras.size(), scene.cameras[size_t(rs.camera)].is_default ? " (default)" : "", size.width,
              size.height);
     // What the scene uses and what the renderer skips (docs/performance.md).
     {
@@ -239,6 +186,7 @@ int run_render(RenderOptions o, const std::string& cmdline, Given&& given) {
     }
     RenderStats stats;
     Film film = renderer.render(&stats);
+    const char* aa_name = aa_mode_name(rs.aa.mode);
 
     const auto t_write = Clock::now();
     const uint64_t rays = stats.rays.total();
@@ -249,17 +197,17 @@ int run_render(RenderOptions o, const std::string& cmdline, Given&& given) {
         "{} refraction, {} aov probe, {} total, {:.2f} Mrays/s on {} threads | aa: {} ({:.3f} camera rays/pixel, "
         "{:.1f}% pixels subdivided)",
         load_s, stats.build_seconds, stats.render_seconds, stats.rays.camera, stats.rays.shadow,
-        stats.rays.reflection, stats.rays.refraction, stats.rays.aov_probe, rays, mrays, stats.threads, o.aa,
+        stats.rays.reflection, stats.rays.refraction, stats.rays.aov_probe, rays, mrays, stats.threads, aa_name,
         stats.pixels ? double(stats.rays.camera) / double(stats.pixels) : 0.0, 100.0 * subdivided);
     os.metadata["whitted:commandLine"] = cmdline;
     os.metadata["whitted:version"] = WHITTED_VERSION;
     os.metadata["whitted:stats"] = summary;
     os.metadata["Software"] = std::string("whitted ") + WHITTED_VERSION;
     g_writing.store(true);
-    write_image(film, o.output, os);
+    write_image(film, c.output, os);
     g_writing.store(false);
     if (g_signal_count.load() > 0) {
-        std::fprintf(stderr, "whitted: interrupted: wrote %s before exiting\n", o.output.c_str());
+        std::fprintf(stderr, "whitted: interrupted: wrote %s before exiting\n", c.output.c_str());
         return 128 + g_last_signal.load();
     }
     const double write_s = seconds_since(t_write);
@@ -272,14 +220,14 @@ int run_render(RenderOptions o, const std::string& cmdline, Given&& given) {
                  "secondary rays below --min-weight %g: %llu\n"
                  "  speed  %.2f Mrays/s on %d threads\n"
                  "  aa     %s: %.3f camera rays/pixel, %.1f%% pixels subdivided\n",
-                 o.output.c_str(), film.width(), film.height(), load_s, stats.build_seconds, stats.render_seconds,
+                 c.output.c_str(), film.width(), film.height(), load_s, stats.build_seconds, stats.render_seconds,
                  write_s, (unsigned long long)stats.rays.camera, (unsigned long long)stats.rays.shadow,
                  (unsigned long long)stats.rays.reflection, (unsigned long long)stats.rays.refraction,
                  (unsigned long long)rays, kernel_name(renderer.kernel()).c_str(),
                  (unsigned long long)stats.rays.shadow_skipped_unreached,
                  (unsigned long long)stats.rays.shadow_skipped_facing,
-                 (unsigned long long)stats.rays.shadow_skipped_zero, double(o.min_weight),
-                 (unsigned long long)stats.rays.secondary_skipped_cutoff, mrays, stats.threads, o.aa.c_str(),
+                 (unsigned long long)stats.rays.shadow_skipped_zero, double(rs.integrator.min_weight),
+                 (unsigned long long)stats.rays.secondary_skipped_cutoff, mrays, stats.threads, aa_name,
                  stats.pixels ? double(stats.rays.camera) / double(stats.pixels) : 0.0, 100.0 * subdivided);
     return 0;
 }
@@ -305,80 +253,107 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"debug", "info", "warning", "error", "off"}))
         ->capture_default_str();
 
-    // whitted render
-    RenderOptions ro;
+    // whitted render: flags set the library's settings directly; colours, AOVs, the crop and the
+    // anti-aliasing names are parsed straight into their types.
+    RenderCommand rc;
+    RenderSettings& rs = rc.render;
     CLI::App* render = app.add_subcommand("render", "Render a scene to an image");
-    render->add_option("scene", ro.input, "Scene file (.gltf, .glb, or a .json scene file: docs/scene-format.md)")->required();
-    render->add_option("-o,--output", ro.output,
+    render->add_option("scene", rc.input, "Scene file (.gltf, .glb, or a .json scene file: docs/scene-format.md)")->required();
+    render->add_option("-o,--output", rc.output,
                        "Output image; the extension picks the format: .exr (scene-linear, AOVs), "
                        ".png/.jpg/.tif (display-referred through OCIO)")
         ->capture_default_str();
-    render->add_option("--width", ro.width, "Image width in pixels (0 = from --height and the camera aspect, else 640)")
+    render->add_option("--width", rs.width,
+                       "Image width in pixels (0 = from the height and the aspect of the scene file or camera, "
+                       "else 640)")
         ->check(CLI::Range(0, 32768))->capture_default_str();
-    render->add_option("--height", ro.height, "Image height in pixels (0 = from the width and the camera aspect)")
+    render->add_option("--height", rs.height,
+                       "Image height in pixels (0 = from the width and the aspect of the scene file or camera)")
         ->check(CLI::Range(0, 32768))->capture_default_str();
-    render->add_option("--camera", ro.camera, "Camera index (see `whitted info`)")->capture_default_str();
-    render->add_option("--scene", ro.scene, "glTF scene index (-1 = the file's default scene)")->capture_default_str();
-    render->add_option("--max-depth", ro.max_depth, "Maximum depth of the ray tree (0 = no reflection/refraction)")
+    render->add_option("--camera", rs.camera, "Camera index (see `whitted info`)")->capture_default_str();
+    render->add_option("--scene", rc.import.scene_index, "glTF scene index (-1 = the file's default scene)")
+        ->capture_default_str();
+    render->add_option("--max-depth", rs.integrator.max_depth,
+                       "Maximum depth of the ray tree (0 = no reflection/refraction)")
         ->check(CLI::Range(0, 64))->capture_default_str();
-    render->add_option("--background", ro.background, "Radiance of rays that hit nothing: r,g,b or gray (linear)")
-        ->capture_default_str();
-    render->add_option("--ambient", ro.ambient, "Ambient light Ia: r,g,b or gray (linear)")->capture_default_str();
-    render->add_option("--exposure", ro.exposure, "Exposure in stops: radiance is scaled by 2^exposure")
-        ->capture_default_str();
-    render->add_option("--min-weight", ro.min_weight,
+    render->add_option_function<std::string>(
+              "--background", [&](const std::string& t) { rs.integrator.background = parse_color(t, "--background"); },
+              "Radiance of rays that hit nothing: r,g,b or gray (linear)")
+        ->default_str(color_text(rs.integrator.background));
+    render->add_option_function<std::string>(
+              "--ambient", [&](const std::string& t) { rs.integrator.ambient = parse_color(t, "--ambient"); },
+              "Ambient light Ia: r,g,b or gray (linear)")
+        ->default_str(color_text(rs.integrator.ambient));
+    render->add_option_function<float>(
+              "--exposure", [&](float stops) { rs.exposure = std::exp2(stops); },
+              "Exposure in stops: radiance is scaled by 2^exposure")
+        ->default_str("0");
+    render->add_option("--min-weight", rs.integrator.min_weight,
                        "Adaptive tree depth (Hall & Greenberg 1983): skip reflected/refracted rays whose accumulated "
                        "weight is below this (default 1/255; 0 = trace to --max-depth)")
         ->check(CLI::Range(0.0f, 1.0f))->capture_default_str();
-    render->add_flag("--no-specialize", ro.no_specialize,
-                     "Use the general shading kernel instead of the one the scene needs (to measure the gain)");
-    render->add_flag("--fresnel", ro.fresnel, "Weight reflection and transmission with Schlick's Fresnel term");
-    render->add_flag("--refract-thin", ro.refract_thin,
+    render->add_flag_function(
+        "--no-specialize", [&](std::int64_t) { rs.integrator.specialize = false; },
+        "Use the general shading kernel instead of the one the scene needs (to measure the gain)");
+    render->add_flag("--fresnel", rs.integrator.fresnel,
+                     "Weight reflection and transmission with Schlick's Fresnel term");
+    render->add_flag("--refract-thin", rs.mapping.refract_thin,
                      "Refract through transmissive materials without KHR_materials_volume (classic glass)");
-    render->add_option("--mirror-cutoff", ro.mirror_cutoff,
+    render->add_option("--mirror-cutoff", rs.mapping.mirror_roughness_cutoff,
                        "Roughness at which mirror reflection has faded to 0 (see docs/materials.md)")
         ->check(CLI::Range(0.0f, 1.0f))->capture_default_str();
-    render->add_option("--aov", ro.aovs, "Extra EXR channels: depth, normal, albedo, primid, instid, aa_samples, all")
+    render->add_option_function<std::vector<std::string>>(
+              "--aov", [&](const std::vector<std::string>& names) { rs.aovs = parse_aovs(names); },
+              "Extra EXR channels: depth, normal, albedo, primid, instid, aa_samples, all")
         ->delimiter(',');
-    render->add_option("--aa", ro.aa, "Anti-aliasing: center, corners, adaptive, stratified (docs/antialiasing.md)")
-        ->check(CLI::IsMember({"center", "corners", "adaptive", "stratified"}))->capture_default_str();
-    render->add_option("--aa-threshold", ro.aa_threshold,
+    render->add_option_function<std::string>(
+              "--aa", [&](const std::string& name) { rs.aa.mode = parse_aa_mode(name); },
+              "Anti-aliasing: center, corners, adaptive, stratified (docs/antialiasing.md)")
+        ->check(CLI::IsMember({"center", "corners", "adaptive", "stratified"}))->default_str(aa_mode_name(rs.aa.mode));
+    render->add_option("--aa-threshold", rs.aa.threshold,
                        "adaptive: split a square when its corners differ by more than this in display-referred "
                        "sRGB values (max channel difference); negative = always split")
         ->capture_default_str();
-    render->add_option("--aa-depth", ro.aa_depth, "adaptive: maximum subdivision depth (sub-squares of 1/2^depth pixel)")
+    render->add_option("--aa-depth", rs.aa.depth, "adaptive: maximum subdivision depth (sub-squares of 1/2^depth pixel)")
         ->check(CLI::Range(0, 8))->capture_default_str();
-    render->add_option("--spp", ro.spp, "stratified: samples per pixel, a square number k*k")
+    render->add_option("--spp", rs.aa.spp, "stratified: samples per pixel, a square number k*k")
         ->check(CLI::Range(1, 4096))->capture_default_str();
-    render->add_option("--filter", ro.filter, "stratified: pixel filter, box or tent (radius 1 pixel)")
-        ->check(CLI::IsMember({"box", "tent"}))->capture_default_str();
-    render->add_option("--crop", ro.crop, "Render only the region x0,y0,x1,y1 (pixels, x1/y1 exclusive)");
-    render->add_option("--threads", ro.threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 1024))
+    render->add_option_function<std::string>(
+              "--filter", [&](const std::string& name) { rs.aa.filter = parse_pixel_filter(name); },
+              "stratified: pixel filter, box or tent (radius 1 pixel)")
+        ->check(CLI::IsMember({"box", "tent"}))->default_str(pixel_filter_name(rs.aa.filter));
+    render->add_option_function<std::string>(
+        "--crop", [&](const std::string& t) { if (!t.empty()) rs.crop = parse_crop(t); },
+        "Render only the region x0,y0,x1,y1 (pixels, x1/y1 exclusive)");
+    render->add_option("--threads", rs.threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 1024))
         ->capture_default_str();
-    render->add_option("--tile-size", ro.tile_size, "Tile size in pixels")->check(CLI::Range(1, 4096))
+    render->add_option("--tile-size", rs.tile_size, "Tile size in pixels")->check(CLI::Range(1, 4096))
         ->capture_default_str();
-    render->add_option("--accel", ro.accel,
+    render->add_option("--accel", rs.accel,
                        "Acceleration structure: embree, bvh, grid, octree, kdop, brute; options after a colon, "
                        "e.g. bvh:precision=double,bv=sphere (docs/accelerators.md)")->capture_default_str();
-    render->add_option("--precision", ro.precision,
+    render->add_option("--precision", rc.precision,
                        "In-house BVH and brute force: trace in float or double (the reference), same as "
                        "--accel bvh:precision=...")->check(CLI::IsMember({"float", "double"}));
-    render->add_option("--bv", ro.bv,
+    render->add_option("--bv", rc.bv,
                        "In-house BVH bounding volume: aabb or sphere (the seed's bounding spheres), same as "
                        "--accel bvh:bv=...")->check(CLI::IsMember({"aabb", "sphere"}));
-    render->add_flag("--robust,!--no-robust", ro.robust,
+    render->add_flag("--robust,!--no-robust", rs.robust,
                      "Embree robust mode (RTC_SCENE_FLAG_ROBUST, the default): no light leaks at shared edges; "
                      "--no-robust is 3-8% faster and leaks a few % of rays aimed at edges and vertices");
-    render->add_option("--ocio-config", ro.ocio_config, "OpenColorIO config (default: $OCIO, else the bundled one)");
-    render->add_option("--display", ro.display, "OCIO display (default: the config's default)");
-    render->add_option("--view", ro.view, "OCIO view: Standard, ACES 1.0 SDR-video, Raw")->capture_default_str();
-    render->add_option("--bits", ro.bits, "Bits per channel for PNG/TIFF: 8 or 16 (0 = format default)")
+    render->add_option("--ocio-config", rc.out.color.config,
+                       "OpenColorIO config (default: $OCIO, else the bundled one)");
+    render->add_option("--display", rc.out.color.display, "OCIO display (default: the config's default)");
+    render->add_option("--view", rc.out.color.view, "OCIO view: Standard, ACES 1.0 SDR-video, Raw")
+        ->capture_default_str();
+    render->add_option("--bits", rc.out.bits, "Bits per channel for PNG/TIFF: 8 or 16 (0 = format default)")
         ->check(CLI::IsMember({0, 8, 16}))->capture_default_str();
-    render->add_flag("--exr-float", ro.exr_float, "Write EXR beauty as 32-bit float instead of half");
-    render->add_flag("--no-progress", ro.no_progress, "Do not draw the progress bar");
-    render->add_option("--max-memory", ro.max_memory_gb, "Refuse scenes whose data would exceed this many GiB")
+    render->add_flag_function("--exr-float", [&](std::int64_t) { rc.out.exr_half = false; },
+                              "Write EXR beauty as 32-bit float instead of half");
+    render->add_flag_function("--no-progress", [&](std::int64_t) { rs.progress = false; }, "Do not draw the progress bar");
+    render->add_option("--max-memory", rc.max_memory_gb, "Refuse scenes whose data would exceed this many GiB")
         ->check(CLI::PositiveNumber)->capture_default_str();
-    render->add_flag("--allow-outside-uris", ro.allow_outside_uris,
+    render->add_flag("--allow-outside-uris", rc.import.allow_outside_uris,
                      "Let the file's external URIs leave its folder (../); absolute and file:// URIs stay refused");
 
     // whitted info
@@ -396,11 +371,11 @@ int main(int argc, char** argv) {
     CLI::App* bench = app.add_subcommand("bench", "Benchmarks: print figures, write CSV and plots");
     bench->require_subcommand(1);
     std::vector<app::Command> commands;
-    // Each benchmark module registers itself here (one line each):
-    commands.push_back(register_bench_aa(*bench));
-    commands.push_back(register_bench_accel(*bench));
-    commands.push_back(register_bench_skip(*bench));
-    commands.push_back(whitted::app::register_bench_stability(*bench));
+    // Each benchmark module registers itself here (one line each; benchmarks/bench_commands.h):
+    commands.push_back(app::register_bench_aa(*bench));
+    commands.push_back(app::register_bench_accel(*bench));
+    commands.push_back(app::register_bench_skip(*bench));
+    commands.push_back(app::register_bench_stability(*bench));
 
     // Global options (--log-level) may also follow the subcommand.
     render->fallthrough();
@@ -408,8 +383,13 @@ int main(int argc, char** argv) {
     bench->fallthrough();
     for (app::Command& c : commands) c.app->fallthrough();
 
+    // Flags parsed into their types (colours, crop, AOVs) throw whitted::Error while CLI11 parses:
+    // reported like every other Error, in one line with exit code 1.
     try {
         app.parse(argc, argv);
+    } catch (const Error& e) {
+        std::fprintf(stderr, "whitted: error: %s\n", e.what());
+        return 1;
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
     } catch (const CLI::CallForAllHelp& e) {
@@ -423,9 +403,15 @@ int main(int argc, char** argv) {
 
     try {
         set_log_level(parse_log_level(log_level));
-        if (render->parsed())
-            return run_render(ro, command_line(argc, argv),
-                              [&](const char* flag) { return render->count(flag) > 0; });
+        if (render->parsed()) {
+            // A setting's scene-file key names its flag: aa_threshold -> --aa-threshold.
+            const SettingGiven flag_given = [&](std::string_view key) {
+                std::string flag = "--" + std::string(key);
+                std::replace(flag.begin(), flag.end(), '_', '-');
+                return render->count(flag) > 0;
+            };
+            return run_render(rc, command_line(argc, argv), flag_given);
+        }
         if (info->parsed()) return run_info(info_input, info_scene, !info_no_textures, info_allow_outside_uris);
         for (app::Command& c : commands)
             if (c.app->parsed()) return c.run();

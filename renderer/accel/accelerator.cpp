@@ -183,4 +183,6 @@ std::unique_ptr<Accelerator> create_accelerator(const std::string& name, const S
     return accel;
 }
 
+void set_accelerator_memory_limit(size_t bytes) { set_embree_memory_limit(bytes); }
+
 }  // namespace whitted

@@ -16,6 +16,7 @@
 // create_accelerator adds.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -165,5 +166,10 @@ const std::vector<std::string>& accelerator_names();
 /// the meshes' index arrays).
 std::unique_ptr<Accelerator> create_accelerator(const std::string& name, const Scene& scene,
                                                 const SurfaceFilter& filter, const AccelConfig& config = {});
+
+/// Ceiling on the bytes accelerator builds may hold at once, all of them together; exceeding it
+/// is a whitted::Error. The Embree backend enforces it through its device memory monitor; the
+/// in-house backends do not check it. Default 8 GiB; the CLI sets it from --max-memory.
+void set_accelerator_memory_limit(size_t bytes);
 
 }  // namespace whitted

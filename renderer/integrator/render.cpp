@@ -129,20 +129,4 @@ Film Renderer::render(const AaSettings& aa, const IntegratorSettings& settings, 
     return film;
 }
 
-void apply_scene_settings(const SceneRenderSettings& s, RenderSettings& rs) {
-    if (s.width) rs.width = *s.width;
-    if (s.height) rs.height = *s.height;
-    if (s.camera) rs.camera = *s.camera;
-    if (s.aa) rs.aa.mode = parse_aa_mode(*s.aa);
-    if (s.aa_threshold) rs.aa.threshold = *s.aa_threshold;
-    if (s.aa_depth) rs.aa.depth = *s.aa_depth;
-    if (s.spp) rs.aa.spp = *s.spp;
-    if (s.max_depth) rs.integrator.max_depth = *s.max_depth;
-    if (s.min_weight) rs.integrator.min_weight = *s.min_weight;
-    if (s.background) rs.integrator.background = *s.background;
-    if (s.ambient) rs.integrator.ambient = *s.ambient;
-    if (s.exposure) rs.exposure = std::exp2(*s.exposure);
-    if (s.fresnel) rs.integrator.fresnel = *s.fresnel;
-}
-
 }  // namespace whitted

@@ -12,6 +12,7 @@
 #include "renderer/film/film.h"
 #include "renderer/integrator/aa_sampler.h"
 #include "renderer/integrator/camera.h"
+#include "renderer/integrator/render_settings.h"
 #include "renderer/integrator/scene_view.h"
 #include "renderer/integrator/whitted_integrator.h"
 
@@ -20,22 +21,6 @@ namespace whitted {
 /// Deepest ray tree a render accepts: the recursion uses the stack (about 1 KB per level), and
 /// 1024 levels stay far inside an 8 MB thread stack (depth 30000 overflowed it).
 constexpr int kMaxTreeDepth = 1024;
-
-struct RenderSettings {
-    int width = 0, height = 0;            ///< pixels; 0 = from the camera's aspect ratio (default 640 wide)
-    int camera = 0;                       ///< index into Scene::cameras
-    IntegratorSettings integrator;        ///< depth, background, ambient, fresnel
-    MappingOptions mapping;               ///< glTF -> Whitted mapping options
-    float exposure = 1.f;                 ///< linear scale applied to the radiance (2^stops from the CLI)
-    int tile_size = 32;                   ///< square tiles of this many pixels
-    int threads = 0;                      ///< 0 = all hardware threads
-    std::optional<PixelWindow> crop;      ///< render only this region of the full image
-    AovSet aovs;                          ///< extra outputs from the pixel-centre camera ray
-    AaSettings aa;                        ///< anti-aliasing mode and its parameters
-    std::string accel = "embree";         ///< accelerator backend
-    bool robust = true;                   ///< Embree ROBUST mode: watertight at edges (docs/numerical-stability.md section 3)
-    bool progress = false;                ///< progress bar with ETA on stderr (when it is a terminal)
-};
 
 struct RenderStats {
     double build_seconds = 0.0;           ///< accelerator build
@@ -81,11 +66,6 @@ private:
     std::unique_ptr<Accelerator> m_accel;
     double m_build_seconds = 0.0;
 };
-
-/// Copies the render settings a scene file carries (size, camera, anti-aliasing, depth, min
-/// weight, background, ambient, exposure in stops, Fresnel) into `rs`; unset values leave `rs` as
-/// it is. Output, OCIO view and display belong to the output stage and are not touched.
-void apply_scene_settings(const SceneRenderSettings& s, RenderSettings& rs);
 
 /// Parses "x0,y0,x1,y1" (pixels, x1/y1 exclusive); throws whitted::Error when malformed.
 PixelWindow parse_crop(const std::string& text);

@@ -449,6 +449,17 @@ void remove_partial_output() noexcept {
     if (g_partial_active.load()) ::unlink(g_partial_path);
 }
 
+void apply_scene_output_settings(const SceneRenderSettings& s, const std::string& scene_path, std::string& output_path,
+                                 OutputSettings& settings, const SettingGiven& given) {
+    auto from_file = [&](std::string_view key) { return !given || !given(key); };
+    if (s.view && from_file("view")) settings.color.view = *s.view;
+    if (s.display && from_file("display")) settings.color.display = *s.display;
+    if (s.output && from_file("output")) {
+        const fs::path out(*s.output);
+        output_path = out.is_absolute() ? out.string() : (fs::path(scene_path).parent_path() / out).string();
+    }
+}
+
 void write_image(const Film& film, const std::string& path, const OutputSettings& settings) {
     const fs::path file(path);
     const std::optional<FileKind> kind = kind_from_extension(file.extension().string());

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "renderer/film/film.h"
+#include "renderer/scene/scene.h"
 
 namespace whitted {
 
@@ -46,6 +47,13 @@ struct OutputSettings {
     bool exr_half = true;                 ///< EXR beauty as half (true) or float (false)
     std::map<std::string, std::string> metadata;  ///< written into EXR headers (and PNG text)
 };
+
+/// Fills the output settings the caller did not set (`given`) from a scene file's: the output
+/// path ("output"; a relative one is taken relative to the folder of `scene_path`, the scene file,
+/// as pbrt does) and the OCIO "view" and "display". Values the file leaves unset keep them as
+/// they are.
+void apply_scene_output_settings(const SceneRenderSettings& s, const std::string& scene_path, std::string& output_path,
+                                 OutputSettings& settings, const SettingGiven& given = {});
 
 /// Writes the film by extension: .exr (scene-linear, AOVs as extra channels, data window =
 /// crop), .png/.jpg/.jpeg/.tif/.tiff (display-referred through OCIO, clamped to [0,1]).

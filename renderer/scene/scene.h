@@ -7,8 +7,10 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "renderer/core/vecmath.h"
@@ -274,6 +276,10 @@ struct SceneRenderSettings {
     std::optional<std::string> display;          ///< OCIO display
     std::optional<int> camera;                   ///< index into Scene::cameras
 };
+
+/// Whether the caller (command line, Python) set a setting itself, named by its scene-file key
+/// ("width", "aa_threshold", "output", ...): such a setting wins over the file's. Empty = none.
+using SettingGiven = std::function<bool(std::string_view key)>;
 
 // ---------------------------------------------------------------------------------------------
 

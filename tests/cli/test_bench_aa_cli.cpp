@@ -4,7 +4,7 @@
 // A 64 px Box keeps it under a second; no time is checked, only what the bench claims.
 #include <gtest/gtest.h>
 
-#include "cli_util.h"
+#include "tests/support/cli_util.h"
 
 #include <algorithm>
 #include <cmath>

@@ -6,7 +6,7 @@
 // about them.
 #include <gtest/gtest.h>
 
-#include "cli_util.h"
+#include "tests/support/cli_util.h"
 
 #include <filesystem>
 #include <map>

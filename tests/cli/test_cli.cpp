@@ -1,8 +1,8 @@
 // The `whitted` program end to end: exit codes, one-line errors, outputs written.
 #include <gtest/gtest.h>
 
-#include "cli_image.h"
-#include "cli_util.h"
+#include "tests/support/cli_image.h"
+#include "tests/support/cli_util.h"
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -191,13 +191,49 @@ TEST(Cli, SceneFileSettingsApplyAndFlagsOverrideThem) {
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(fs::exists(from_file));
     EXPECT_NE(r.err.find("(24x16)"), std::string::npos) << r.err;
-    // Flags win over the file, each on its own: width from the flag, height still from the file.
+    // Flags win over the file, each on its own: the depth from the flag, the size still the file's.
     const fs::path out = fs::temp_directory_path() / "whitted_cli_override.png";
     fs::remove(out);
-    r = run("render '" + scene.string() + "' --no-progress --width 30 -o '" + out.string() + "'");
+    r = run("render '" + scene.string() + "' --no-progress --max-depth 0 -o '" + out.string() + "'");
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(fs::exists(out));
-    EXPECT_NE(r.err.find("(30x16)"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("(24x16)"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("reflection 0  refraction 0"), std::string::npos) << r.err;
+}
+
+/// The size `whitted render` reports for `scene` rendered with `flags` ("" when it failed).
+std::string rendered_size(const fs::path& scene, const std::string& flags) {
+    const fs::path out = scene.parent_path() / "size.png";
+    const Result r = run("render '" + scene.string() + "' --no-progress " + flags + " -o '" + out.string() + "'");
+    const size_t open = r.err.find(".png ("), close = r.err.find(')', open);
+    return r.code == 0 && open != std::string::npos ? r.err.substr(open + 6, close - open - 6) : "";
+}
+
+/// The scene file kSmallScene with its `render` size replaced by `size` (e.g. "\"width\": 40").
+fs::path small_scene_sized(const std::string& name, const std::string& size) {
+    const std::string file_size = "\"width\": 24, \"height\": 16";
+    std::string text = kSmallScene;
+    text.replace(text.find(file_size), file_size.size(), size);
+    return write_scene_file(name, text);
+}
+
+// docs/cli.md, "Image size": one size flag keeps the aspect ratio of the file's size when the
+// file gives both, else the camera's (4:3 for a scene-file camera); two flags are the size.
+TEST(Cli, OneSizeFlagKeepsTheAspectRatio) {
+    const fs::path both = write_scene_file("size_both.json", kSmallScene);  // 24x16
+    EXPECT_EQ(rendered_size(both, ""), "24x16");
+    EXPECT_EQ(rendered_size(both, "--width 30"), "30x20");
+    EXPECT_EQ(rendered_size(both, "--height 8"), "12x8");
+    EXPECT_EQ(rendered_size(both, "--width 30 --height 30"), "30x30");
+    EXPECT_EQ(rendered_size(both, "--width 0 --height 8"), "12x8");  // 0 = not given
+    // The file gives one dimension: the other follows the camera's aspect, with or without a flag.
+    const fs::path width_only = small_scene_sized("size_width.json", "\"width\": 40");
+    EXPECT_EQ(rendered_size(width_only, ""), "40x30");
+    EXPECT_EQ(rendered_size(width_only, "--height 15"), "20x15");
+    EXPECT_EQ(rendered_size(width_only, "--width 20"), "20x15");
+    const fs::path height_only = small_scene_sized("size_height.json", "\"height\": 30");
+    EXPECT_EQ(rendered_size(height_only, ""), "40x30");
+    EXPECT_EQ(rendered_size(height_only, "--width 20"), "20x15");
 }
 
 TEST(Cli, BadSceneFileIsOneLineWithLineAndColumn) {

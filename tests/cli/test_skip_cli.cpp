@@ -3,8 +3,8 @@
 // tests/cli/test_cli.cpp runs it).
 #include <gtest/gtest.h>
 
-#include "cli_image.h"
-#include "cli_util.h"
+#include "tests/support/cli_image.h"
+#include "tests/support/cli_util.h"
 
 #include <filesystem>
 #include <map>

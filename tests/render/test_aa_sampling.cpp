@@ -12,12 +12,10 @@
 
 #include "renderer/core/error.h"
 #include "renderer/integrator/render.h"
-#include "tests/support/scene_builder.h"
+#include "renderer/scene/scene_builder.h"
 
 namespace whitted {
 namespace {
-
-using namespace whitted::test;
 
 /// Orthographic camera looking down -z whose image x equals world x + width / 2 (square pixels of
 /// one world unit), and a flat half-plane x < edge_x (image coordinates) of constant radiance 1

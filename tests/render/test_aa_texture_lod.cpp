@@ -5,13 +5,11 @@
 #include <algorithm>
 
 #include "renderer/integrator/render.h"
+#include "renderer/scene/scene_builder.h"
 #include "shading/texture_sampling.h"
-#include "tests/support/scene_builder.h"
 
 namespace whitted {
 namespace {
-
-using namespace whitted::test;
 
 /// An unlit quad [-8, 8]^2 with a 256 x 256 one-texel checkerboard (black / white, linear data),
 /// seen by an orthographic camera of `size` pixels over the quad.

@@ -16,7 +16,7 @@
 
 #include "importers/scene_loader.h"
 #include "renderer/integrator/render.h"
-#include "tests/unit/test_accel_util.h"
+#include "tests/support/test_accel_util.h"
 
 namespace whitted {
 namespace {

@@ -9,14 +9,12 @@
 #include <string>
 
 #include "renderer/integrator/render.h"
+#include "renderer/scene/scene_builder.h"
 #include "shading/light_sample.h"
 #include "shading/optics.h"
-#include "tests/support/scene_builder.h"
 
 namespace whitted {
 namespace {
-
-using namespace whitted::test;
 
 Vec3f random_unit(std::mt19937& rng) {
     std::normal_distribution<float> g(0.f, 1.f);

@@ -16,12 +16,10 @@
 
 #include "renderer/integrator/render.h"
 #include "renderer/integrator/whitted_integrator.h"
-#include "tests/support/scene_builder.h"
+#include "renderer/scene/scene_builder.h"
 
 namespace whitted {
 namespace {
-
-using namespace whitted::test;
 
 /// Box-local frame placed in the world (+y up, as in glTF): yaw about +y and a translation in the
 /// floor's plane, so the coordinates are not exact binary fractions (as in default.glb) while

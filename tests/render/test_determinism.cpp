@@ -7,12 +7,10 @@
 
 #include "renderer/core/fp_mode.h"
 #include "renderer/integrator/render.h"
-#include "tests/support/scene_builder.h"
+#include "renderer/scene/scene_builder.h"
 
 namespace whitted {
 namespace {
-
-using namespace whitted::test;
 
 /// Floor, a mirror box, a refracting glass box, a thin tinted panel, two lights.
 Scene glass_and_shadows_scene() {

@@ -6,12 +6,10 @@
 
 #include "renderer/core/error.h"
 #include "renderer/integrator/render.h"
-#include "tests/support/scene_builder.h"
+#include "renderer/scene/scene_builder.h"
 
 namespace whitted {
 namespace {
-
-using namespace whitted::test;
 
 constexpr float kTol = 1e-4f;
 

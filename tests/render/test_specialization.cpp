@@ -11,13 +11,11 @@
 
 #include "importers/scene_loader.h"
 #include "renderer/integrator/render.h"
+#include "renderer/scene/scene_builder.h"
 #include "shading/scene_analysis.h"
-#include "tests/support/scene_builder.h"
 
 namespace whitted {
 namespace {
-
-using namespace whitted::test;
 
 const std::string kAssets = WHITTED_ASSETS_DIR;
 

@@ -12,10 +12,10 @@
 #include <limits>
 #include <string>
 
+#include "benchmarks/stability_probes.h"
 #include "importers/scene_loader.h"
-#include "tests/stress/stability_probes.h"
-#include "tests/support/scene_builder.h"
-#include "tests/unit/test_importer_util.h"
+#include "renderer/scene/scene_builder.h"
+#include "tests/support/test_importer_util.h"
 
 namespace whitted::stress {
 namespace {

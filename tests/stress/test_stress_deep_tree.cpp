@@ -6,14 +6,12 @@
 #include <cmath>
 #include <string>
 
+#include "benchmarks/stability_probes.h"
 #include "renderer/core/error.h"
-#include "tests/stress/stability_probes.h"
-#include "tests/support/scene_builder.h"
+#include "renderer/scene/scene_builder.h"
 
 namespace whitted::stress {
 namespace {
-
-using namespace whitted::test;
 
 /// Mirrors z = 0 (facing +z) and z = d (facing -z), ka = 0.5, kr = r, nothing else; ambient 0.2,
 /// so every bounce adds a = 0.1 and the pixel after max depth D is a sum_{k=0..D} r^k.

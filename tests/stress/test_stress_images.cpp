@@ -7,8 +7,8 @@
 #include <cmath>
 #include <string>
 
+#include "benchmarks/stability_probes.h"
 #include "importers/scene_loader.h"
-#include "tests/stress/stability_probes.h"
 
 namespace whitted::stress {
 namespace {

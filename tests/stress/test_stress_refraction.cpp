@@ -7,17 +7,15 @@
 #include <cmath>
 #include <string>
 
+#include "benchmarks/stability_probes.h"
 #include "importers/scene_loader.h"
 #include "renderer/core/ray_offset.h"
 #include "renderer/integrator/whitted_integrator.h"
+#include "renderer/scene/scene_builder.h"
 #include "shading/optics.h"
-#include "tests/stress/stability_probes.h"
-#include "tests/support/scene_builder.h"
 
 namespace whitted::stress {
 namespace {
-
-using namespace whitted::test;
 
 const double kAnglesDeg[] = {0.0, 30.0, 60.0, 80.0, 89.0, 89.9, 89.99};
 

@@ -9,8 +9,8 @@
 #include <random>
 #include <string>
 
+#include "benchmarks/stability_probes.h"
 #include "renderer/core/ray_offset.h"
-#include "tests/stress/stability_probes.h"
 
 namespace whitted::stress {
 namespace {

@@ -22,7 +22,7 @@
 #include "renderer/accel/bvh/bvh_accel.h"
 #include "renderer/accel/bvh/wide_bvh.h"
 #include "renderer/core/error.h"
-#include "tests/unit/test_accel_util.h"
+#include "tests/support/test_accel_util.h"
 
 namespace whitted {
 namespace {

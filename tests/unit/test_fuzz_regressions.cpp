@@ -13,7 +13,7 @@
 #include "importers/image_decode.h"
 #include "importers/scene_report.h"
 #include "shading/texture_sampling.h"
-#include "test_importer_util.h"
+#include "tests/support/test_importer_util.h"
 
 namespace whitted {
 namespace {

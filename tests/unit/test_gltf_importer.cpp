@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "test_importer_util.h"
+#include "tests/support/test_importer_util.h"
 
 namespace whitted::test {
 namespace {

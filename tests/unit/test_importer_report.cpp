@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "importers/scene_report.h"
-#include "test_importer_util.h"
+#include "tests/support/test_importer_util.h"
 
 namespace whitted::test {
 namespace {

@@ -19,7 +19,7 @@
 #include "renderer/accel/accelerator.h"
 #include "renderer/accel/common/planes.h"
 #include "renderer/accel/common/sphere.h"
-#include "tests/unit/test_accel_util.h"
+#include "tests/support/test_accel_util.h"
 
 namespace whitted {
 namespace {

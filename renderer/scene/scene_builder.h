@@ -1,4 +1,6 @@
-// Helpers that build small analytic scenes in code for the integrator tests.
+// Building small scenes in code: materials, meshes (quads, boxes), cameras and point lights added
+// to a Scene directly, for analytic test scenes, the stability probes and programs that make
+// their scenes without a file.
 #pragma once
 
 #include <cmath>
@@ -6,7 +8,7 @@
 
 #include "renderer/scene/scene.h"
 
-namespace whitted::test {
+namespace whitted {
 
 /// Adds a Classic material (Whitted's (1980) coefficients) and returns its index.
 inline uint32_t add_classic_material(Scene& s, const WhittedCoeffs& c, const std::string& name = "classic") {
@@ -85,6 +87,7 @@ inline Camera make_camera(CameraType type, Vec3d eye, Vec3d forward, Vec3d up, d
     return c;
 }
 
+/// A point light at `pos`: radiant intensity `intensity * color` (renderer units, docs/lights.md).
 inline Light point_light(Vec3d pos, float intensity, Color color = Color(1.f)) {
     Light l;
     l.type = LightType::Point;
@@ -94,4 +97,4 @@ inline Light point_light(Vec3d pos, float intensity, Color color = Color(1.f)) {
     return l;
 }
 
-}  // namespace whitted::test
+}  // namespace whitted

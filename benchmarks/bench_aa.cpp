@@ -25,9 +25,9 @@
 #include <string>
 #include <vector>
 
-#include "apps/whitted/bench_timing.h"
-#include "apps/whitted/command.h"
-#include "apps/whitted/ray_recording.h"
+#include "benchmarks/bench_commands.h"
+#include "benchmarks/bench_timing.h"
+#include "benchmarks/ray_recording.h"
 #include "importers/scene_loader.h"
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"

@@ -36,10 +36,10 @@
 #include <string>
 #include <vector>
 
-#include "apps/whitted/bench_timing.h"
-#include "apps/whitted/command.h"
-#include "apps/whitted/ray_recording.h"
-#include "importers/scene_file_geometry.h"
+#include "benchmarks/bench_commands.h"
+#include "benchmarks/bench_timing.h"
+#include "benchmarks/ray_recording.h"
+#include "importers/mesh_normals.h"
 #include "importers/scene_loader.h"
 #include "renderer/accel/accelerator.h"
 #include "renderer/core/error.h"

@@ -52,9 +52,9 @@
 
 #include <time.h>
 
-#include "apps/whitted/bench_timing.h"
-#include "apps/whitted/command.h"
-#include "apps/whitted/ray_recording.h"
+#include "benchmarks/bench_commands.h"
+#include "benchmarks/bench_timing.h"
+#include "benchmarks/ray_recording.h"
 #include "importers/scene_loader.h"
 #include "renderer/core/fp_mode.h"
 #include "renderer/accel/embree/embree_ray.h"

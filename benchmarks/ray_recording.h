@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "apps/whitted/bench_timing.h"
+#include "benchmarks/bench_timing.h"
 #include "renderer/accel/accelerator.h"
 
 namespace whitted::app {

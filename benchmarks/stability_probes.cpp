@@ -1,5 +1,5 @@
 // Numerical stability probes (see stability_probes.h and docs/numerical-stability.md).
-#include "tests/stress/stability_probes.h"
+#include "benchmarks/stability_probes.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

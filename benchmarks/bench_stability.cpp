@@ -1,5 +1,5 @@
 // `whitted bench stability`: the full numerical-stability sweep of issue #7 (the bounded version
-// runs in CI as `ctest -L stress`). Same probes as the tests (tests/stress/stability_probes.h):
+// runs in CI as `ctest -L stress`). Same probes as the tests (benchmarks/stability_probes.h):
 // self-intersection at any scale (the current offset against the previous one), image invariance
 // under scale and translation, watertightness (10M rays per backend and mesh), energy bound,
 // refraction through slabs near grazing, deep ray trees and hit-point error. Writes
@@ -15,14 +15,14 @@
 #include <string>
 #include <vector>
 
-#include "apps/whitted/command.h"
+#include "benchmarks/bench_commands.h"
+#include "benchmarks/stability_probes.h"
 #include "importers/scene_loader.h"
 #include "renderer/core/error.h"
 #include "renderer/core/ray_offset.h"
 #include "renderer/integrator/render.h"
+#include "renderer/scene/scene_builder.h"
 #include "shading/optics.h"
-#include "tests/stress/stability_probes.h"
-#include "tests/support/scene_builder.h"
 
 namespace whitted::app {
 
@@ -324,7 +324,6 @@ void run_deep(Csv& csv) {
     std::printf("\n## 5. Parallel mirrors (kr 0.9, Ia Ka 0.1): radiance against a (1 - r^(D+1)) / (1 - r)\n\n"
                 "| max depth | pixel | series | relative error | reflection rays per pixel | seconds |\n"
                 "|---:|---:|---:|---:|---:|---:|\n");
-    using namespace whitted::test;
     for (int depth : {1, 2, 5, 10, 20, 50, 100, 200}) {
         Scene s;
         WhittedCoeffs c;

@@ -1,0 +1,27 @@
+// The `whitted bench` subcommands (docs/performance.md): each adds itself under the CLI's `bench`
+// command, so main.cpp only lists them.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace whitted::app {
+
+/// A subcommand added under a parent: `app` is what CLI11 parsed into, `run` does the work and
+/// returns the exit code (throwing whitted::Error for bad input, like everything else).
+struct Command {
+    CLI::App* app = nullptr;
+    std::function<int()> run;
+};
+
+/// `whitted bench aa`: error against run time for every anti-aliasing mode (bench_aa.cpp).
+Command register_bench_aa(CLI::App& bench);
+/// `whitted bench accel`: build time, memory and Mrays/s of every accelerator (bench_accel.cpp).
+Command register_bench_accel(CLI::App& bench);
+/// `whitted bench skip`: what specialised kernels and skipped rays save (bench_skip.cpp).
+Command register_bench_skip(CLI::App& bench);
+/// `whitted bench stability`: the numerical-stability sweep (bench_stability.cpp).
+Command register_bench_stability(CLI::App& bench);
+
+}  // namespace whitted::app

@@ -1,0 +1,48 @@
+#include "renderer/integrator/render_settings.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace whitted {
+
+namespace {
+
+/// `length` scaled by the ratio `to / from`, rounded to the nearest pixel, at least 1.
+int keep_aspect(int length, int to, int from) {
+    return std::max(1, int(std::lround(double(length) * double(to) / double(from))));
+}
+
+/// The image size from the caller's width/height (0 = not set) and the file's.
+void merge_image_size(const SceneRenderSettings& s, RenderSettings& rs, bool width_given, bool height_given) {
+    const bool w = width_given && rs.width > 0, h = height_given && rs.height > 0;
+    if (w && h) return;
+    if (!w && !h) {
+        if (s.width) rs.width = *s.width;
+        if (s.height) rs.height = *s.height;
+        return;
+    }
+    // One dimension given: the other keeps the file's aspect, or the camera's (0) without one.
+    const bool file_aspect = s.width && s.height;
+    if (w) rs.height = file_aspect ? keep_aspect(rs.width, *s.height, *s.width) : 0;
+    else rs.width = file_aspect ? keep_aspect(rs.height, *s.width, *s.height) : 0;
+}
+
+}  // namespace
+
+void apply_scene_settings(const SceneRenderSettings& s, RenderSettings& rs, const SettingGiven& given) {
+    auto from_file = [&](std::string_view key) { return !given || !given(key); };
+    merge_image_size(s, rs, !from_file("width"), !from_file("height"));
+    if (s.camera && from_file("camera")) rs.camera = *s.camera;
+    if (s.aa && from_file("aa")) rs.aa.mode = parse_aa_mode(*s.aa);
+    if (s.aa_threshold && from_file("aa_threshold")) rs.aa.threshold = *s.aa_threshold;
+    if (s.aa_depth && from_file("aa_depth")) rs.aa.depth = *s.aa_depth;
+    if (s.spp && from_file("spp")) rs.aa.spp = *s.spp;
+    if (s.max_depth && from_file("max_depth")) rs.integrator.max_depth = *s.max_depth;
+    if (s.min_weight && from_file("min_weight")) rs.integrator.min_weight = *s.min_weight;
+    if (s.background && from_file("background")) rs.integrator.background = *s.background;
+    if (s.ambient && from_file("ambient")) rs.integrator.ambient = *s.ambient;
+    if (s.exposure && from_file("exposure")) rs.exposure = std::exp2(*s.exposure);
+    if (s.fresnel && from_file("fresnel")) rs.integrator.fresnel = *s.fresnel;
+}
+
+}  // namespace whitted
