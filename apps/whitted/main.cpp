@@ -336,7 +336,7 @@ int main(int argc, char** argv) {
                        "In-house BVH and brute force: trace in float or double (the reference), same as "
                        "--accel bvh:precision=...")->check(CLI::IsMember({"float", "double"}));
     render->add_option("--bv", rc.bv,
-                       "In-house BVH bounding volume: aabb or sphere (the seed's bounding spheres), same as "
+                       "In-house BVH bounding volume: aabb or sphere (Whitted's (1980) bounding spheres), same as "
                        "--accel bvh:bv=...")->check(CLI::IsMember({"aabb", "sphere"}));
     render->add_flag("--robust,!--no-robust", rs.robust,
                      "Embree robust mode (RTC_SCENE_FLAG_ROBUST, the default): no light leaks at shared edges; "
