@@ -1,4 +1,4 @@
-// `whitted bench stability`: the full numerical-stability sweep of issue #7 (the bounded version
+// `whitted bench stability`: the full numerical-stability sweep (the bounded version
 // runs in CI as `ctest -L stress`). Same probes as the tests (benchmarks/stability_probes.h):
 // self-intersection at any scale (the current offset against the previous one), image invariance
 // under scale and translation, watertightness (10M rays per backend and mesh), energy bound,

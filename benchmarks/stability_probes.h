@@ -1,4 +1,4 @@
-// Numerical stability probes (issue #7, docs/numerical-stability.md): the measurements behind
+// Numerical stability probes (docs/numerical-stability.md): the measurements behind
 // `ctest -L stress` (bounded) and `whitted bench stability` (the full sweep). Each probe builds
 // its scene in code, traces rays through the real accelerators and the integrator's own hit-point
 // code (SceneView) and returns counts and error figures; the tests assert on them, the benchmark
@@ -47,7 +47,7 @@ bool is_closed_mesh(const Mesh& mesh);
 /// by default the backend's RayOffsetPolicy, as the renderer does.
 using OffsetFn = std::function<Vec3f(const Vec3f& p, float scale, const Vec3f& n)>;
 
-/// The offset before issue #7 (Wächter & Binder 2019 as published: 256 ulps of each coordinate,
+/// The earlier offset (Wächter & Binder 2019 as published: 256 ulps of each coordinate,
 /// 1/65536 absolute below 1/32), kept to show the suite catches what it got wrong. It knows only
 /// the point: `scale` is ignored.
 Vec3f wachter_binder_2019(const Vec3f& p, float scale, const Vec3f& n);
