@@ -9,6 +9,7 @@
 // its line:column; unknown keys and names come with a "did you mean" suggestion.
 
 #include "importers/scene_file.h"
+#include "importers/environment_image.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -116,8 +117,8 @@ public:
         m_scene.source = m_doc.path;
         const Json& root = m_doc.root;
         check_object(root, "", "the scene file",
-                     {"$schema", "comment", "version", "render", "ambient", "camera", "textures", "materials",
-                      "objects", "include", "lights"});
+                     {"$schema", "comment", "version", "render", "ambient", "environment", "camera", "textures",
+                      "materials", "objects", "include", "lights"});
         read_version(root);
         if (const Json* t = member(root, "textures")) read_textures(*t);
         if (const Json* m = member(root, "materials")) read_materials(*m);
@@ -127,6 +128,7 @@ public:
         if (const Json* i = member(root, "include")) read_includes(*i);
         if (const Json* a = member(root, "ambient")) m_scene.settings.ambient = color(*a, "/ambient");
         if (const Json* r = member(root, "render")) read_render(*r);
+        if (const Json* e = member(root, "environment")) read_environment(*e);
 
         if (m_scene.materials.empty()) default_material();
         add_scene_defaults(m_scene, m_options, m_warnings);
@@ -1074,6 +1076,40 @@ private:
             else it->required = it->required || e.required;
         }
         for (const std::string& w : inc.warnings) m_scene.warn(fmt::format("{}: {}", file, w));
+    }
+
+    // ---- environment --------------------------------------------------------------------------
+    /// "environment": a file or bundled name, or {"file", "rotation", "exposure", "visible"}.
+    void read_environment(const Json& v) {
+        const std::string p = "/environment";
+        Environment env;
+        std::string file;
+        if (v.is_string()) {
+            file = string(v, p);
+        } else {
+            check_object(v, p, "the environment", {"file", "rotation", "exposure", "visible", "comment"});
+            const Json* f = member(v, "file");
+            if (!f) fail(p, "the environment needs a \"file\" (a lat-long image or a bundled name)");
+            file = string(*f, sub(p, "file"));
+            if (const Json* x = member(v, "rotation")) env.rotation_deg = float(number(*x, sub(p, "rotation"), Range{-3600.0, 3600.0}));
+            if (const Json* x = member(v, "exposure")) env.exposure_stops = float(number(*x, sub(p, "exposure"), Range{-64.0, 64.0}));
+            if (const Json* x = member(v, "visible")) env.visible = boolean(*x, sub(p, "visible"));
+        }
+        if (!m_options.environment.empty() || m_options.no_environment) return;  // replaced by the caller's
+        // A path relative to the scene file, else a bundled name (resolve_environment_name).
+        fs::path path(file);
+        if (path.is_relative()) path = m_dir / path;
+        std::error_code ec;
+        const std::string where = fs::exists(path, ec) ? path.lexically_normal().string() : file;
+        std::vector<std::string> warnings;
+        try {
+            env.image = std::make_shared<EnvironmentImage>(
+                load_environment_image(resolve_environment_name(where), m_options.max_memory, warnings));
+        } catch (const Error& e) {
+            fail(v.is_string() ? p : sub(p, "file"), "{}", e.what());
+        }
+        for (const std::string& w : warnings) m_scene.warn(w);
+        m_scene.environment = std::move(env);
     }
 
     // ---- render settings ----------------------------------------------------------------------

@@ -14,11 +14,15 @@ namespace whitted {
 Scene load_scene(const std::string& path, const ImportOptions& options) {
     std::string ext = std::filesystem::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    if (ext == ".gltf" || ext == ".glb") return import_gltf(path, options);
-    if (ext == ".json") return import_scene_file(path, options);
-    throw Error(file_loc(path),
+    Scene scene;
+    if (ext == ".gltf" || ext == ".glb") scene = import_gltf(path, options);
+    else if (ext == ".json") scene = import_scene_file(path, options);
+    else
+        throw Error(file_loc(path),
                 ext.empty() ? std::string("file has no extension: cannot tell its format (supported: .gltf, .glb, .json)")
                             : "unsupported scene file extension '" + ext + "' (supported: .gltf, .glb, .json)");
+    setup_environment(scene, options);
+    return scene;
 }
 
 }  // namespace whitted

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -19,7 +20,20 @@ struct ImportOptions {
     bool load_textures = true;                  ///< false: skip image decoding (faster `info`)
     bool allow_outside_uris = false;            ///< external URIs may leave the file's folder ("../");
                                                 ///< absolute and file:// URIs are refused either way
+    // The environment (docs/environment.md): what rays that leave the scene see, and its light.
+    std::string environment;                    ///< lat-long map (file or bundled name) replacing the scene's;
+                                                ///< empty = the scene file's, if any
+    std::optional<float> environment_rotation;  ///< degrees about +Y; unset = the scene file's (or 0)
+    std::optional<float> environment_exposure;  ///< stops; unset = the scene file's (or 0)
+    bool no_environment = false;                ///< no environment at all, whatever the file says
+    int environment_lights = 16;                ///< lights extracted from it (0 = all of its light is ambient)
 };
+
+/// Sets up the scene's environment after import: the one `options` names replaces the file's
+/// (rotation and exposure overrides apply to either), then its light is split into directional
+/// lights (appended to scene.lights, replacing the default light) and the SH ambient. Throws
+/// whitted::Error for a map that cannot be read.
+void setup_environment(Scene& scene, const ImportOptions& options);
 
 /// Loads a scene, dispatching on the extension: .gltf, .glb (import_gltf), .json (the scene file,
 /// import_scene_file in importers/scene_file.h).

@@ -1,6 +1,7 @@
 // `whitted info`: what the importer made of a file, one greppable record per line.
 
 #include "importers/scene_report.h"
+#include "shading/environment_map.h"
 
 #include <cmath>
 #include <numbers>
@@ -166,7 +167,30 @@ std::string describe_scene(const Scene& scene) {
         if (l.type != LightType::Directional) s += fmt::format(" position={}", vec3(l.position));
         if (l.type != LightType::Point) s += fmt::format(" direction={}", vec3(l.direction));
         s += fmt::format(" attenuation={} default={}", attenuation_name(l.attenuation), yes_no(l.is_default));
+        if (l.from_environment) s += " environment=yes";
         line(s);
+    }
+    if (scene.environment && scene.environment->image) {
+        const Environment& e = *scene.environment;
+        size_t from_env = 0;
+        Color power(0.f);
+        for (const Light& l : scene.lights)
+            if (l.from_environment) {
+                ++from_env;
+                power += l.color * l.intensity;
+            }
+        line(fmt::format("environment: name=\"{}\" size={}x{} rotation={} exposure={} visible={} lights={} "
+                         "lights_intensity={}",
+                         e.image->name, e.image->width, e.image->height, num(e.rotation_deg), num(e.exposure_stops),
+                         yes_no(e.visible), from_env, vec3(power)));
+        if (e.ambient_sh) {
+            // The ambient part as irradiance (renderer units: a constant radiance L gives L) along the axes.
+            const auto& sh = *e.ambient_sh;
+            auto E = [&](const Vec3f& n) { return sh9_irradiance(sh, n); };
+            line(fmt::format("environment ambient: +X={} -X={} +Y={} -Y={} +Z={} -Z={}", vec3(E({1, 0, 0})),
+                             vec3(E({-1, 0, 0})), vec3(E({0, 1, 0})), vec3(E({0, -1, 0})), vec3(E({0, 0, 1})),
+                             vec3(E({0, 0, -1}))));
+        }
     }
 
     for (size_t i = 0; i < scene.cameras.size(); ++i) {

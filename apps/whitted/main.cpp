@@ -132,6 +132,21 @@ struct RenderCommand {
     double max_memory_gb = 8.0;                 ///< ImportOptions::max_memory and the accelerators', in GiB
 };
 
+/// The environment flags (docs/environment.md), shared by `render` and `info`.
+void add_environment_options(CLI::App* app, ImportOptions& io) {
+    app->add_option("--environment", io.environment,
+                    "Lat-long HDR map around the scene (a file, or a bundled name: studio, city, courtyard, "
+                    "forest, interior, sunset); replaces the scene file's");
+    app->add_option_function<float>("--env-rotate", [&io](const float& deg) { io.environment_rotation = deg; },
+                                    "Turn the environment about +Y by this many degrees");
+    app->add_option_function<float>("--env-exposure", [&io](const float& stops) { io.environment_exposure = stops; },
+                                    "Scale the environment's radiance by 2^stops");
+    app->add_option("--env-lights", io.environment_lights,
+                    "Directional lights extracted from the environment's brightest regions (0 = all of its light "
+                    "is ambient)")->check(CLI::Range(0, 4096))->capture_default_str();
+    app->add_flag("--no-environment", io.no_environment, "No environment, whatever the scene file names");
+}
+
 /// `--precision` and `--bv` are shorthands for the accelerator spec's options of the same names
 /// (`--accel bvh --precision double` == `--accel bvh:precision=double`): each given one is appended
 /// to the spec, whose parser rejects it, naming the backend, where it does not apply.
@@ -216,7 +231,8 @@ int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& 
                  "whitted: wrote %s (%dx%d)\n"
                  "  time   load %.3fs  build %.3fs  render %.3fs  write %.3fs\n"
                  "  rays   camera %llu  shadow %llu  reflection %llu  refraction %llu  total %llu\n"
-                 "  skip   %s; shadow rays not cast: %llu unreached, %llu facing away, %llu with a zero term; "
+                 "  skip   %s; shadow rays not cast: %llu unreached, %llu facing away, %llu with a zero term, "
+                 "%llu too dim; "
                  "secondary rays below --min-weight %g: %llu\n"
                  "  speed  %.2f Mrays/s on %d threads\n"
                  "  aa     %s: %.3f camera rays/pixel, %.1f%% pixels subdivided\n",
@@ -226,17 +242,14 @@ int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& 
                  (unsigned long long)rays, kernel_name(renderer.kernel()).c_str(),
                  (unsigned long long)stats.rays.shadow_skipped_unreached,
                  (unsigned long long)stats.rays.shadow_skipped_facing,
-                 (unsigned long long)stats.rays.shadow_skipped_zero, double(rs.integrator.min_weight),
+                 (unsigned long long)stats.rays.shadow_skipped_zero,
+                 (unsigned long long)stats.rays.shadow_skipped_dim, double(rs.integrator.min_weight),
                  (unsigned long long)stats.rays.secondary_skipped_cutoff, mrays, stats.threads, aa_name,
                  stats.pixels ? double(stats.rays.camera) / double(stats.pixels) : 0.0, 100.0 * subdivided);
     return 0;
 }
 
-int run_info(const std::string& input, int scene_index, bool textures, bool allow_outside_uris) {
-    ImportOptions io;
-    io.scene_index = scene_index;
-    io.load_textures = textures;
-    io.allow_outside_uris = allow_outside_uris;
+int run_info(const std::string& input, const ImportOptions& io) {
     Scene scene = load_scene(input, io);
     std::fputs(describe_scene(scene).c_str(), stdout);
     return 0;
@@ -355,17 +368,20 @@ int main(int argc, char** argv) {
         ->check(CLI::PositiveNumber)->capture_default_str();
     render->add_flag("--allow-outside-uris", rc.import.allow_outside_uris,
                      "Let the file's external URIs leave its folder (../); absolute and file:// URIs stay refused");
+    add_environment_options(render, rc.import);
 
     // whitted info
     std::string info_input;
-    int info_scene = -1;
-    bool info_no_textures = false, info_allow_outside_uris = false;
+    ImportOptions info_import;
     CLI::App* info = app.add_subcommand("info", "Print what a scene file contains after import");
     info->add_option("scene", info_input, "Scene file (.gltf, .glb or .json)")->required();
-    info->add_option("--scene", info_scene, "glTF scene index (-1 = the file's default scene)")->capture_default_str();
-    info->add_flag("--no-textures", info_no_textures, "Skip decoding images");
-    info->add_flag("--allow-outside-uris", info_allow_outside_uris,
+    info->add_option("--scene", info_import.scene_index, "glTF scene index (-1 = the file's default scene)")
+        ->capture_default_str();
+    info->add_flag_function("--no-textures", [&](std::int64_t) { info_import.load_textures = false; },
+                            "Skip decoding images");
+    info->add_flag("--allow-outside-uris", info_import.allow_outside_uris,
                    "Let the file's external URIs leave its folder (../); absolute and file:// URIs stay refused");
+    add_environment_options(info, info_import);
 
     // whitted bench <name>: benchmarks print figures and write CSV/plots (docs/performance.md).
     CLI::App* bench = app.add_subcommand("bench", "Benchmarks: print figures, write CSV and plots");
@@ -412,7 +428,7 @@ int main(int argc, char** argv) {
             };
             return run_render(rc, command_line(argc, argv), flag_given);
         }
-        if (info->parsed()) return run_info(info_input, info_scene, !info_no_textures, info_allow_outside_uris);
+        if (info->parsed()) return run_info(info_input, info_import);
         for (app::Command& c : commands)
             if (c.app->parsed()) return c.run();
     } catch (const Error& e) {

@@ -18,6 +18,7 @@ struct RayCounters {
     uint64_t shadow_skipped_unreached = 0;  ///< light beyond its range, outside its cone, or culled per object
     uint64_t shadow_skipped_facing = 0;     ///< light behind the surface (N.L <= 0)
     uint64_t shadow_skipped_zero = 0;       ///< nothing to shadow: kd = 0 and the highlight below the cutoff
+    uint64_t shadow_skipped_dim = 0;        ///< an environment light's term below min_weight at the point
     uint64_t secondary_skipped_cutoff = 0;  ///< secondary rays whose path weight fell below min_weight
     uint64_t contact_probe = 0;             ///< short queries for a coincident face (contacts.h); not in total()
     uint64_t total() const { return camera + shadow + reflection + refraction + aov_probe; }
@@ -29,6 +30,7 @@ struct RayCounters {
         shadow_skipped_unreached += o.shadow_skipped_unreached;
         shadow_skipped_facing += o.shadow_skipped_facing;
         shadow_skipped_zero += o.shadow_skipped_zero;
+        shadow_skipped_dim += o.shadow_skipped_dim;
         secondary_skipped_cutoff += o.secondary_skipped_cutoff;
         contact_probe += o.contact_probe;
         return *this;

@@ -43,6 +43,10 @@ void apply_scene_settings(const SceneRenderSettings& s, RenderSettings& rs, cons
     if (s.ambient && from_file("ambient")) rs.integrator.ambient = *s.ambient;
     if (s.exposure && from_file("exposure")) rs.exposure = std::exp2(*s.exposure);
     if (s.fresnel && from_file("fresnel")) rs.integrator.fresnel = *s.fresnel;
+    // An environment's light replaces the constant ambient unless one was set; camera rays that
+    // miss see it unless the caller set a background.
+    if (s.ambient || !from_file("ambient")) rs.integrator.environment_ambient = false;
+    if (!from_file("background")) rs.integrator.environment_visible = false;
 }
 
 }  // namespace whitted

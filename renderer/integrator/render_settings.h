@@ -31,8 +31,9 @@ struct RenderSettings {
 
 /// Fills every setting of `rs` the caller did not set (`given`) from a scene file's settings `s`
 /// (size, camera, anti-aliasing, depth, min weight, background, ambient, exposure in stops,
-/// Fresnel); what the file leaves unset keeps `rs`. Image size (docs/cli.md, "Image size"; 0 = not
-/// set): a width or height set alone keeps the file's aspect ratio when the file gives both, else
+/// Fresnel); what the file leaves unset keeps `rs`. An ambient from the file or the caller turns the
+/// environment's ambient off; a background from the caller hides the environment from camera rays.
+/// Image size (docs/cli.md, "Image size"; 0 = not set): a width or height set alone keeps the file's aspect ratio when the file gives both, else
 /// the other becomes 0 (the camera's aspect completes it). Output path, OCIO view and display
 /// belong to the output stage (apply_scene_output_settings).
 void apply_scene_settings(const SceneRenderSettings& s, RenderSettings& rs, const SettingGiven& given = {});

@@ -4,11 +4,13 @@
 // materials there. It is also the SurfaceFilter backends consult during traversal.
 #pragma once
 
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/scene/scene.h"
+#include "shading/environment_map.h"
 #include "shading/material_mapping.h"
 #include "shading/scene_analysis.h"
 
@@ -68,6 +70,8 @@ public:
     const MappingOptions& mapping() const { return m_mapping; }
     /// What the scene uses, analysed with this view's mapping options.
     const SceneAnalysis& analysis() const { return m_analysis; }
+    /// The scene's environment as a filtered map, or null when the scene has none.
+    const EnvironmentMap* environment() const { return m_environment.get(); }
     /// The lights that may reach the object hit (SceneAnalysis::lights_of), ascending.
     std::span<const uint32_t> lights_reaching(const Hit& hit) const {
         return m_analysis.lights_of(object_index(m_scene, hit.geom, hit.inst));
@@ -98,6 +102,7 @@ private:
     std::vector<uint8_t> m_needs_uv;  ///< per material: some texture is read through UVs (not a
                                       ///< world-space checker); 0 = surface() skips UVs and MIP levels
     SceneAnalysis m_analysis;
+    std::shared_ptr<const EnvironmentMap> m_environment;  ///< built from scene.environment
 };
 
 extern template SurfacePoint SceneView::surface<true>(const Ray&, const Hit&, const RayCone&) const;

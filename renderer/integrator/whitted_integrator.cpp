@@ -43,7 +43,7 @@ PrimaryInfo first_hit(const Hit& hit, const Vec3f& N, const WhittedCoeffs& c) {
 template <KernelFeatures K>
 Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCounters& counters,
                                PrimaryInfo* primary, const RayCone& cone, float weight) const {
-    if (!hit.valid()) return m_settings.background;
+    if (!hit.valid()) return missed(ray, depth, cone);
     const MaterialFeatures& mf = features(hit);
     const SurfacePoint sp = surface_point<K>(ray, hit, mf, cone);
     if constexpr (K.transmission) {
@@ -62,7 +62,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
     const bool unlit = s.mat.model == MaterialModel::GltfPbr && s.mat.unlit;  // KHR_materials_unlit
     if (!unlit) {
         // I = emission + Ia ka + sum_i Is_i fat_i s_i (kd N.L_i + ks (N.H_i)^n) + kt T + kr R
-        I = direct_light<K>(I + m_settings.ambient * c.ka, s, counters);
+        I = direct_light<K>(I + ambient_light(s) * c.ka, s, counters);
         if constexpr (K.mirror || K.transmission) {
             if (depth < m_settings.max_depth) {
                 auto [kr, kt] = secondary_weights(c.ks, c.kr, c.kt, std::clamp(dot(s.f.N, s.f.V), 0.f, 1.f),
@@ -75,6 +75,18 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
     }
     if constexpr (K.transmission) I = blend_behind<K>(s, absorbed(s, I), counters);
     return sanitize(I);
+}
+
+// ---- What surrounds the scene: the environment ------------------------------------------------
+
+Color WhittedIntegrator::missed(const Ray& ray, int depth, const RayCone& cone) const {
+    if (m_environment && (depth > 0 || (m_settings.environment_visible && m_environment->visible())))
+        return m_environment->radiance(ray.dir, cone.spread);
+    return m_settings.background;
+}
+
+Color WhittedIntegrator::ambient_light(const Shading& s) const {
+    return m_ambient_sh ? sh9_irradiance(*m_ambient_sh, s.f.N) : m_settings.ambient;
 }
 
 // ---- Direct light: sum_i Is_i fat_i s_i (kd N.L_i + ks (N.H_i)^n) --------------------------
@@ -102,6 +114,11 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         const Color term = local_term(c, s.f.N, ls.L, s.f.V, n_dot_l);
         if (is_black(term)) {  // kd = 0 and the highlight below its cutoff
             ++counters.shadow_skipped_zero;
+            return;
+        }
+        // One of many lights cut from the environment, too dim here to change the pixel.
+        if (light.from_environment && s.weight * max_component(ls.intensity * term) < m_settings.min_weight) {
+            ++counters.shadow_skipped_dim;
             return;
         }
         if (!shadow_org) shadow_org = m_offset.origin(s.f.front ? s.sp.p_shadow : s.sp.p, s.sp.offset_scale, s.f.Ng);
@@ -339,6 +356,9 @@ WhittedIntegrator::WhittedIntegrator(const SceneView& view, const Accelerator& a
     };
     pick(std::make_index_sequence<std::size(kKernels)>{});
     RT_CHECK(m_trace != nullptr);
+    m_environment = view.environment();
+    const std::optional<Environment>& env = view.scene().environment;
+    if (env && env->ambient_sh && settings.environment_ambient) m_ambient_sh = &*env->ambient_sh;
     if (m_kernel.transmission) {
         m_contacts = DielectricContacts::find(view);
         m_covers = OpaqueCovers::find(view);

@@ -30,6 +30,10 @@ struct IntegratorSettings {
                                        ///< is traced only while the product of the kr/kt weights along
                                        ///< its path (max over channels) is >= this; 0 = depth limit only
     bool specialize = true;            ///< pick the kernel the scene needs; false = the general kernel
+    bool environment_ambient = true;   ///< with an environment, Ia is its ambient light (SH irradiance at N);
+                                       ///< false (an `ambient` given): the constant `ambient`
+    bool environment_visible = true;   ///< camera rays that miss see the environment; false (a `background`
+                                       ///< given, or the environment's `visible` false): the background
 };
 
 class DielectricContacts;
@@ -101,6 +105,11 @@ private:
                 const RayCone& cone, float weight) const;
 
     // The terms of the formula, each at one hit (whitted_integrator.cpp).
+    /// What a ray that leaves the scene sees: the environment (filtered by the ray's cone), or the
+    /// background (no environment, or a camera ray when the environment is not visible).
+    Color missed(const Ray& ray, int depth, const RayCone& cone) const;
+    /// Ia at the hit: the environment's ambient light in the direction of N, or the constant.
+    Color ambient_light(const Shading& s) const;
     template <KernelFeatures K>
     Color direct_light(Color sum, const Shading& s, RayCounters& counters) const;
     template <KernelFeatures K>
@@ -142,6 +151,8 @@ private:
     RayOffsetPolicy m_offset;  ///< m_accel's: how far secondary-ray origins leave their surface
     IntegratorSettings m_settings;
     KernelFeatures m_kernel;
+    const EnvironmentMap* m_environment = nullptr;             ///< null: misses see the background
+    const std::array<Color, 9>* m_ambient_sh = nullptr;        ///< null: the constant ambient
     TraceFn m_trace = nullptr;          ///< trace<m_kernel>
     CameraFn m_trace_camera = nullptr;  ///< trace_camera<m_kernel>
     std::shared_ptr<const DielectricContacts> m_contacts;  ///< null when no dielectrics touch

@@ -3,7 +3,9 @@
 // shading/environment_map.h, the light it casts. Axis convention and units: docs/environment.md.
 #pragma once
 
+#include <array>
 #include <cstddef>
+#include <optional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -32,6 +34,9 @@ struct Environment {
     float rotation_deg = 0.f;         ///< turn about +Y, degrees, right-hand rule (+90 moves the map's centre from +X to -Z)
     float exposure_stops = 0.f;       ///< the map's radiance is scaled by 2^exposure_stops
     bool visible = true;              ///< false: camera rays that miss show the background colour instead
+    /// The light not extracted as lights, as radiance SH coefficients (bands 0-2, world space;
+    /// shading/environment_map.h): the ambient term. Set by the importer with the lights.
+    std::optional<std::array<Color, 9>> ambient_sh;
 };
 
 }  // namespace whitted

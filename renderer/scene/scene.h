@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "renderer/core/vecmath.h"
+#include "renderer/scene/environment.h"
 
 namespace whitted {
 
@@ -226,6 +227,7 @@ struct Light {
     Attenuation attenuation = Attenuation::InverseSquare;
     Vec3f classic_c{1.f, 0.f, 0.f};   ///< c1, c2, c3 for Attenuation::Classic
     bool is_default = false;          ///< added because the scene had no light
+    bool from_environment = false;    ///< extracted from the environment (skipped where too dim to matter)
 };
 
 enum class CameraType : uint8_t { Perspective, Orthographic };
@@ -292,6 +294,7 @@ struct Scene {
     std::vector<Material> materials;  ///< never empty after import (a default material is added)
     std::vector<Texture> textures;
     std::vector<Light> lights;
+    std::optional<Environment> environment;  ///< what rays that leave the scene see, and its light
     std::vector<Camera> cameras;
     std::vector<ExtensionUse> extensions;
     std::vector<std::string> warnings;  ///< each distinct warning once

@@ -1,0 +1,54 @@
+// The environment step of every import (load_scene): which map, then its light as lights + ambient.
+#include <algorithm>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "importers/environment_image.h"
+#include "importers/scene_loader.h"
+#include "renderer/core/log.h"
+#include "shading/environment_map.h"
+
+namespace whitted {
+
+namespace {
+
+void add_warning(Scene& scene, const std::string& w) {
+    if (std::find(scene.warnings.begin(), scene.warnings.end(), w) == scene.warnings.end()) scene.warnings.push_back(w);
+}
+
+}  // namespace
+
+void setup_environment(Scene& scene, const ImportOptions& options) {
+    if (options.no_environment) {
+        scene.environment.reset();
+        return;
+    }
+    if (!options.environment.empty()) {
+        std::vector<std::string> warnings;
+        const std::string path = resolve_environment_name(options.environment);
+        auto image = std::make_shared<EnvironmentImage>(load_environment_image(path, options.max_memory, warnings));
+        for (const std::string& w : warnings) add_warning(scene, w);
+        Environment env;
+        env.image = std::move(image);
+        scene.environment = std::move(env);
+    }
+    if (!scene.environment) return;
+    Environment& env = *scene.environment;
+    if (options.environment_rotation) env.rotation_deg = *options.environment_rotation;
+    if (options.environment_exposure) env.exposure_stops = *options.environment_exposure;
+
+    // Its light: the brightest regions as directional lights, the rest as the SH ambient. The
+    // lights replace the default light a scene without lights was given.
+    const EnvironmentMap map(env);
+    const EnvironmentLighting lighting = map.split(std::max(options.environment_lights, 0));
+    std::erase_if(scene.lights, [](const Light& l) { return l.is_default; });
+    for (size_t k = 0; k < lighting.lights.size(); ++k) {
+        Light light = to_directional_light(lighting.lights[k], fmt::format("environment light {}", k));
+        light.from_environment = true;
+        scene.lights.push_back(light);
+    }
+    env.ambient_sh = lighting.residual_sh;
+}
+
+}  // namespace whitted

@@ -1,0 +1,185 @@
+// The environment through the renderer: the white furnace, what missed rays see, and the same
+// environment given by flag (ImportOptions) or by the scene file.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include "importers/scene_loader.h"
+#include "renderer/core/error.h"
+#include "renderer/integrator/render.h"
+#include "renderer/scene/scene_builder.h"
+
+namespace whitted {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A lat-long of constant radiance L.
+Environment constant_environment(Color L) {
+    auto image = std::make_shared<EnvironmentImage>();
+    image->name = "constant";
+    image->width = 64;
+    image->height = 32;
+    image->texels.assign(64 * 32, L);
+    Environment env;
+    env.image = image;
+    return env;
+}
+
+/// One unit sphere at the origin of material `c`, seen from +Z, under `env`.
+Scene sphere_under(const WhittedCoeffs& c, const Environment& env, int env_lights) {
+    Scene s;
+    Sphere sphere;
+    sphere.center = {0, 0, 0};
+    sphere.radius = 1.0;
+    sphere.material = add_classic_material(s, c);
+    s.spheres.push_back(sphere);
+    s.cameras.push_back(make_camera(CameraType::Perspective, {0, 0, 4}, {0, 0, -1}, {0, 1, 0}, 0.7));
+    s.environment = env;
+    ImportOptions io;
+    io.environment_lights = env_lights;
+    setup_environment(s, io);
+    return s;
+}
+
+Film render(const Scene& scene, const IntegratorSettings& integrator = {}) {
+    RenderSettings rs;
+    rs.width = rs.height = 32;
+    rs.threads = 1;
+    rs.integrator = integrator;
+    return Renderer(scene, rs).render();
+}
+
+void expect_near_rel(const Color& got, const Color& want, float rel) {
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], want[k], rel * want[k]) << "channel " << k;
+}
+
+// A white diffuse sphere (kd = ka = 1) under a constant environment of radiance L has radiance L:
+// it vanishes against the background, whether the light is all ambient or partly extracted.
+TEST(EnvironmentRender, WhiteFurnace) {
+    const Color L(0.5f, 0.8f, 1.2f);
+    WhittedCoeffs white;
+    white.kd = white.ka = Color(1.f);
+    for (int lights : {0, 1, 16}) {
+        SCOPED_TRACE("env lights " + std::to_string(lights));
+        const Film film = render(sphere_under(white, constant_environment(L), lights));
+        expect_near_rel(film.beauty[film.index(16, 16)], L, 0.01f);  // the sphere's centre
+        expect_near_rel(film.beauty[film.index(12, 20)], L, 0.01f);  // off centre, still on it
+        expect_near_rel(film.beauty[film.index(0, 0)], L, 1e-5f);    // a miss sees the map
+    }
+}
+
+// A mirror reflects the environment; a hidden environment (a background given) still lights and
+// is still reflected, only camera rays that miss show the background.
+TEST(EnvironmentRender, MissedRaysSeeTheEnvironment) {
+    const Color L(0.25f, 0.5f, 0.75f);
+    WhittedCoeffs mirror;
+    mirror.kr = Color(1.f);
+    const Scene scene = sphere_under(mirror, constant_environment(L), 0);
+    IntegratorSettings hidden;
+    hidden.background = Color(0.f, 1.f, 0.f);
+    hidden.environment_visible = false;
+    for (const IntegratorSettings& settings : {IntegratorSettings{}, hidden}) {
+        const Film film = render(scene, settings);
+        expect_near_rel(film.beauty[film.index(16, 16)], L, 1e-5f);
+    }
+    const Film film = render(scene, hidden);
+    EXPECT_EQ(film.beauty[film.index(0, 0)], hidden.background);
+}
+
+// The constant ambient replaces the environment's when asked (an `ambient` given).
+TEST(EnvironmentRender, ConstantAmbientWhenGiven) {
+    WhittedCoeffs ambient_only;
+    ambient_only.ka = Color(1.f);
+    const Scene scene = sphere_under(ambient_only, constant_environment(Color(2.f)), 0);
+    IntegratorSettings constant;
+    constant.ambient = Color(0.25f);
+    constant.environment_ambient = false;
+    expect_near_rel(render(scene).beauty[16 * 32 + 16], Color(2.f), 0.01f);
+    EXPECT_EQ(render(scene, constant).beauty[16 * 32 + 16], Color(0.25f));
+}
+
+/// A scene file with a plane, a sphere and a light, and optionally an environment entry.
+fs::path write_scene(const fs::path& dir, const std::string& name, const std::string& environment) {
+    const fs::path path = dir / name;
+    std::ofstream out(path);
+    out << R"({"version": 1,
+      "camera": {"type": "perspective", "position": [0, 1, 4], "look_at": [0, 0.5, 0], "up": [0, 1, 0], "fov": 40},
+      "materials": {"white": {"kd": 0.7, "ka": 0.7, "ks": 0.3, "n": 40, "kr": 0.2}},
+      "objects": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "u_axis": [1, 0, 0], "material": "white"},
+                  {"type": "sphere", "center": [0, 0.6, 0], "radius": 0.6, "material": "white"}],
+      "lights": [{"type": "point", "position": [2, 4, 3], "intensity": 6}])"
+        << environment << "}\n";
+    return path;
+}
+
+fs::path temp_dir(const std::string& name) {
+    const fs::path dir = fs::temp_directory_path() / ("whitted_env_" + name + "_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    return dir;
+}
+
+const std::string kCourtyard = std::string(WHITTED_SOURCE_DIR) + "/assets/environments/courtyard.exr";
+
+// The same environment from the flag or from the scene file gives the same image, bit for bit.
+TEST(EnvironmentRender, FlagAndSceneFileAgree) {
+    const fs::path dir = temp_dir("agree");
+    const fs::path plain = write_scene(dir, "plain.json", "");
+    const fs::path named = write_scene(dir, "named.json",
+                                       R"(, "environment": {"file": ")" + kCourtyard + R"(", "rotation": 90, "exposure": -1})");
+    ImportOptions flag;
+    flag.environment = "courtyard";
+    flag.environment_rotation = 90.f;
+    flag.environment_exposure = -1.f;
+    const Scene a = load_scene(plain.string(), flag);
+    const Scene b = load_scene(named.string());
+    ASSERT_TRUE(a.environment && b.environment);
+    EXPECT_EQ(a.lights.size(), b.lights.size());
+    const Film fa = render(a), fb = render(b);
+    ASSERT_EQ(fa.beauty.size(), fb.beauty.size());
+    size_t differ = 0;
+    for (size_t i = 0; i < fa.beauty.size(); ++i) differ += !(fa.beauty[i] == fb.beauty[i]);
+    EXPECT_EQ(differ, 0u);
+    // And the environment changes the image (it is not ignored).
+    const Film fc = render(load_scene(plain.string()));
+    size_t changed = 0;
+    for (size_t i = 0; i < fa.beauty.size(); ++i) changed += !(fa.beauty[i] == fc.beauty[i]);
+    EXPECT_GT(changed, fa.beauty.size() / 2);
+    // --no-environment removes it again.
+    ImportOptions none;
+    none.no_environment = true;
+    EXPECT_FALSE(load_scene(named.string(), none).environment);
+    fs::remove_all(dir);
+}
+
+// A map that cannot be read is one error naming it (and the scene file's pointer).
+TEST(EnvironmentRender, MissingMapIsALocatedError) {
+    const fs::path dir = temp_dir("missing");
+    const fs::path plain = write_scene(dir, "plain.json", "");
+    ImportOptions flag;
+    flag.environment = (dir / "nowhere.exr").string();
+    try {
+        load_scene(plain.string(), flag);
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("nowhere.exr"), std::string::npos) << e.what();
+    }
+    const fs::path named = write_scene(dir, "named.json", R"(, "environment": {"file": "nowhere.exr"})");
+    try {
+        load_scene(named.string());
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("/environment/file"), std::string::npos) << what;
+        EXPECT_NE(what.find("nowhere.exr"), std::string::npos) << what;
+    }
+    fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace whitted
