@@ -1,0 +1,37 @@
+// The environment: a lat-long (equirectangular) HDR image surrounding the scene at infinity, as
+// plain data. What a ray that leaves the scene sees (Whitted 1980) and, through
+// shading/environment_map.h, the light it casts. Axis convention and units: docs/environment.md.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "renderer/core/vecmath.h"
+
+namespace whitted {
+
+/// A decoded lat-long image: column u = (x + 0.5) / width runs once around +Y, row 0 is the +Y
+/// pole side and the last row the -Y side (docs/environment.md, "Axis convention").
+struct EnvironmentImage {
+    std::string name;                 ///< bundled name ("studio") or the file name, for messages
+    std::string path;                 ///< file it was read from; empty when built in memory
+    int width = 0, height = 0;        ///< texels
+    std::vector<Color> texels;        ///< width * height linear RGB radiances, row-major, each >= 0 and finite
+
+    /// Texel at column x, row y (unchecked).
+    const Color& at(int x, int y) const { return texels[size_t(y) * size_t(width) + size_t(x)]; }
+    /// Bytes held by the texels.
+    size_t bytes() const { return texels.size() * sizeof(Color); }
+};
+
+/// An environment as a scene or the command line names it.
+struct Environment {
+    std::shared_ptr<const EnvironmentImage> image;  ///< never null in a valid environment
+    float rotation_deg = 0.f;         ///< turn about +Y, degrees, right-hand rule (+90 moves the map's centre from +X to -Z)
+    float exposure_stops = 0.f;       ///< the map's radiance is scaled by 2^exposure_stops
+    bool visible = true;              ///< false: camera rays that miss show the background colour instead
+};
+
+}  // namespace whitted
