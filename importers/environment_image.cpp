@@ -1,0 +1,124 @@
+// OpenImageIO -> EnvironmentImage (linear RGB), with the limits checked from the header first.
+
+#include "importers/environment_image.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "importers/image_decode.h"
+#include "renderer/core/error.h"
+#include "shading/environment_map.h"
+
+namespace whitted {
+
+namespace {
+
+std::string one_line(std::string s) {
+    for (char& c : s)
+        if ((unsigned char)c < 0x20 || c == 0x7f) c = ' ';
+    while (!s.empty() && s.back() == ' ') s.pop_back();
+    return s;
+}
+
+/// sRGB transfer -> linear (IEC 61966-2-1) for a value in [0, 1].
+float srgb_to_linear(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
+
+}  // namespace
+
+const std::vector<std::string>& bundled_environment_names() {
+    static const std::vector<std::string> names{"studio", "city", "courtyard", "forest", "interior", "sunset"};
+    return names;
+}
+
+std::string resolve_environment_name(const std::string& name) {
+    std::error_code ec;
+    if (std::filesystem::exists(name, ec)) return name;
+    const auto& names = bundled_environment_names();
+    if (std::find(names.begin(), names.end(), name) != names.end())
+        return std::string(WHITTED_SOURCE_DIR) + "/assets/environments/" + name + ".exr";
+    throw Error(fmt::format("environment '{}': no such file, and not a bundled name ({})", name, fmt::join(names, ", ")));
+}
+
+size_t environment_load_bytes(int width, int height, int channels) {
+    const size_t texels = size_t(std::max(width, 0)) * size_t(std::max(height, 0));
+    return texels * size_t(std::max(channels, 1)) * sizeof(float) + texels * sizeof(Color) +
+           EnvironmentMap::estimated_bytes(width, height);
+}
+
+EnvironmentImage load_environment_image(const std::string& path, size_t max_memory_bytes,
+                                        std::vector<std::string>& warnings) {
+    FileLoc loc;
+    loc.file = path;
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw Error(loc, "cannot read the environment map: no such file");
+    if (!std::filesystem::is_regular_file(path, ec)) throw Error(loc, "cannot read the environment map: not a file");
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) {
+        const std::string why = one_line(OIIO::geterror());
+        throw Error(loc, fmt::format("cannot read the environment map: not an image OpenImageIO reads ({})",
+                                     why.empty() ? "unknown format" : why));
+    }
+
+    // The header first: a small file must not make us allocate a huge image.
+    const OIIO::ImageSpec& spec = in->spec();
+    if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1)
+        throw Error(loc, fmt::format("the environment map is empty ({}x{}, {} channels)", spec.width, spec.height,
+                                     spec.nchannels));
+    if (spec.depth > 1) throw Error(loc, fmt::format("the environment map is a volume ({} slices)", spec.depth));
+    if (spec.width > kMaxImageSide || spec.height > kMaxImageSide)
+        throw Error(loc, fmt::format("the environment map is {}x{}, more than the {} texels per side whitted accepts",
+                                     spec.width, spec.height, kMaxImageSide));
+    const int channels = spec.nchannels >= 3 ? 3 : 1;  // RGB, or grey (a second channel is alpha)
+    const size_t needed = environment_load_bytes(spec.width, spec.height, channels);
+    if (needed > max_memory_bytes)
+        throw Error(loc, fmt::format("the environment map is {}x{}: loading it needs about {} MiB, more than the limit "
+                                     "of {} MiB (--max-memory)",
+                                     spec.width, spec.height, (needed + (1u << 20) - 1) >> 20, max_memory_bytes >> 20));
+    if (spec.width != 2 * spec.height)
+        warnings.push_back(fmt::format("environment map '{}' is {}x{}, not 2:1: a lat-long map spans 360 x 180 "
+                                       "degrees, so its texels are stretched",
+                                       path, spec.width, spec.height));
+
+    // Integer files hold sRGB-encoded values (PNG, JPEG) unless they say they are linear.
+    const std::string color_space = spec.get_string_attribute("oiio:ColorSpace");
+    const bool srgb = !spec.format.is_floating_point() && color_space != "Linear" && color_space != "linear";
+
+    const size_t texels = size_t(spec.width) * size_t(spec.height);
+    std::vector<float> px(texels * size_t(channels));
+    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, px.data()))
+        throw Error(loc, fmt::format("cannot read the environment map: {}", one_line(in->geterror())));
+    in->close();
+
+    EnvironmentImage image;
+    image.name = std::filesystem::path(path).stem().string();
+    image.path = path;
+    image.width = spec.width;
+    image.height = spec.height;
+    image.texels.resize(texels);
+    size_t clamped = 0;
+    for (size_t i = 0; i < texels; ++i) {
+        const float* v = &px[i * size_t(channels)];
+        float rgb[3] = {v[0], channels == 3 ? v[1] : v[0], channels == 3 ? v[2] : v[0]};
+        bool bad = false;
+        for (float& c : rgb) {
+            if (!std::isfinite(c) || c < 0.f) {
+                c = 0.f;
+                bad = true;
+            }
+            if (srgb) c = srgb_to_linear(std::min(c, 1.f));
+        }
+        clamped += bad ? 1 : 0;
+        image.texels[i] = {rgb[0], rgb[1], rgb[2]};
+    }
+    if (clamped > 0)
+        warnings.push_back(fmt::format("environment map '{}': {} texels with negative, NaN or infinite values set to 0",
+                                       path, clamped));
+    return image;
+}
+
+}  // namespace whitted
