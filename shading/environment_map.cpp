@@ -1,0 +1,582 @@
+// Environment map: MIP lat-long lookups, the median-cut split into lights plus SH9 ambient, and
+// the GGX prefilter for rough reflections (docs/environment.md).
+
+#include "shading/environment_map.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "renderer/core/error.h"
+#include "renderer/core/fp_mode.h"
+#include "renderer/core/parallel.h"
+
+namespace whitted {
+
+namespace {
+
+constexpr double kTwoPiD = 2.0 * kPiD;
+/// Samples per prefiltered texel (a fixed Hammersley set: every texel sees the same pattern).
+constexpr int kPrefilterSamples = 256;
+/// Width of each prefiltered level (height = width / 2), per kPrefilterRoughness.
+constexpr std::array<int, 4> kPrefilterWidth{128, 64, 32, 32};
+
+/// Rec. 709 luminance of linear RGB.
+double luminance(const Color& c) { return 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z); }
+
+/// Solid angle of one texel of row y of a width x height lat-long (exact for the row's band).
+double texel_solid_angle(int y, int width, int height) {
+    return kTwoPiD / width * (std::cos(kPiD * y / height) - std::cos(kPiD * (y + 1) / height));
+}
+
+/// Texel-centre directions and solid angles of a width x height lat-long, from per-row and
+/// per-column tables.
+class TexelGrid {
+public:
+    TexelGrid(int width, int height) : m_cos_phi(size_t(width)), m_sin_phi(size_t(width)), m_sin_theta(size_t(height)),
+                                       m_cos_theta(size_t(height)), m_solid_angle(size_t(height)) {
+        for (int x = 0; x < width; ++x) {
+            const double phi = kTwoPiD * ((x + 0.5) / width - 0.5);
+            m_cos_phi[size_t(x)] = std::cos(phi), m_sin_phi[size_t(x)] = std::sin(phi);
+        }
+        for (int y = 0; y < height; ++y) {
+            const double theta = kPiD * (y + 0.5) / height;
+            m_sin_theta[size_t(y)] = std::sin(theta), m_cos_theta[size_t(y)] = std::cos(theta);
+            m_solid_angle[size_t(y)] = texel_solid_angle(y, width, height);
+        }
+    }
+    /// Unit map-local direction of the centre of texel (x, y).
+    Vec3d direction(int x, int y) const {
+        const double s = m_sin_theta[size_t(y)];
+        return {s * m_cos_phi[size_t(x)], m_cos_theta[size_t(y)], s * m_sin_phi[size_t(x)]};
+    }
+    /// Solid angle of one texel of row y.
+    double solid_angle(int y) const { return m_solid_angle[size_t(y)]; }
+
+private:
+    std::vector<double> m_cos_phi, m_sin_phi, m_sin_theta, m_cos_theta, m_solid_angle;
+};
+
+/// Source texels under destination texel i when `src` texels shrink to `dst`, with their
+/// overlap [a, b) in source texel units.
+struct Tap {
+    int src = 0;
+    double a = 0, b = 0;
+};
+std::vector<std::vector<Tap>> footprints(int src, int dst) {
+    std::vector<std::vector<Tap>> out(static_cast<size_t>(dst));
+    const double step = double(src) / dst;
+    for (int i = 0; i < dst; ++i) {
+        const double lo = i * step, hi = (i + 1) * step;
+        for (int s = int(std::floor(lo)); s < src && s < hi; ++s) {
+            const double a = std::max(lo, double(s)), b = std::min(hi, double(s + 1));
+            if (b > a) out[size_t(i)].push_back({s, a, b});
+        }
+    }
+    return out;
+}
+
+/// The pole values of a level: the mean of its first and last rows.
+void set_poles(EnvironmentMap::Level& level) {
+    Vec3d top(0.0), bottom(0.0);
+    for (int x = 0; x < level.width; ++x) {
+        top += Vec3d(level.texels[size_t(x)]);
+        bottom += Vec3d(level.texels[size_t(level.height - 1) * size_t(level.width) + size_t(x)]);
+    }
+    level.pole_top = Color(top / double(level.width));
+    level.pole_bottom = Color(bottom / double(level.width));
+}
+
+/// Next MIP level: each texel is the solid-angle weighted mean of the source texels its
+/// footprint covers (a 2x2 box for even sizes, overlap-weighted for odd ones).
+EnvironmentMap::Level downsample(const EnvironmentMap::Level& src) {
+    EnvironmentMap::Level dst;
+    dst.width = std::max(1, src.width / 2);
+    dst.height = std::max(1, src.height / 2);
+    dst.texels.resize(size_t(dst.width) * size_t(dst.height));
+    const auto across = footprints(src.width, dst.width);
+    const auto down = footprints(src.height, dst.height);
+    for (int y = 0; y < dst.height; ++y)
+        for (int x = 0; x < dst.width; ++x) {
+            Vec3d sum(0.0);
+            double weight = 0;
+            for (const Tap& ty : down[size_t(y)]) {
+                // Solid angle of the covered part of the source row (proportional to it).
+                const double wy = std::cos(kPiD * ty.a / src.height) - std::cos(kPiD * ty.b / src.height);
+                for (const Tap& tx : across[size_t(x)]) {
+                    const double w = wy * (tx.b - tx.a);
+                    sum += Vec3d(src.texels[size_t(ty.src) * size_t(src.width) + size_t(tx.src)]) * w;
+                    weight += w;
+                }
+            }
+            dst.texels[size_t(y) * size_t(dst.width) + size_t(x)] = Color(weight > 0 ? sum / weight : Vec3d(0.0));
+        }
+    set_poles(dst);
+    return dst;
+}
+
+/// Radical inverse in base 2 (van der Corput), the second Hammersley coordinate.
+float radical_inverse2(uint32_t k) {
+    k = (k << 16u) | (k >> 16u);
+    k = ((k & 0x55555555u) << 1u) | ((k & 0xAAAAAAAAu) >> 1u);
+    k = ((k & 0x33333333u) << 2u) | ((k & 0xCCCCCCCCu) >> 2u);
+    k = ((k & 0x0F0F0F0Fu) << 4u) | ((k & 0xF0F0F0F0u) >> 4u);
+    k = ((k & 0x00FF00FFu) << 8u) | ((k & 0xFF00FF00u) >> 8u);
+    return float(k) * 2.3283064365386963e-10f;
+}
+
+/// A region of the median cut: texels [x0, x1) x [y0, y1) and their energy.
+struct Region {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    double energy = 0;
+    bool splittable = true;
+};
+
+/// Summed-area table of one value per texel (double), queried per rectangle.
+class SummedArea {
+public:
+    SummedArea(int width, int height) : m_width(width), m_sum(size_t(width + 1) * size_t(height + 1), 0.0) {}
+    void set_row(int y, const std::vector<double>& values) {
+        double run = 0;
+        for (int x = 0; x < m_width; ++x) {
+            run += values[size_t(x)];
+            at(x + 1, y + 1) = at(x + 1, y) + run;
+        }
+    }
+    double rect(int x0, int y0, int x1, int y1) const { return at(x1, y1) - at(x0, y1) - at(x1, y0) + at(x0, y0); }
+    size_t bytes() const { return m_sum.size() * sizeof(double); }
+
+private:
+    double& at(int x, int y) { return m_sum[size_t(y) * size_t(m_width + 1) + size_t(x)]; }
+    double at(int x, int y) const { return m_sum[size_t(y) * size_t(m_width + 1) + size_t(x)]; }
+    int m_width;
+    std::vector<double> m_sum;
+};
+
+/// Debevec's (2005) cut of `r` in two along its longer side in angle (the width scaled by the
+/// sine of the polar angle at its centre), at the texel boundary nearest the energy median.
+/// False when the region is one texel.
+bool cut_region(const Region& r, const SummedArea& sat, int width, int height, Region& a, Region& b) {
+    const int nx = r.x1 - r.x0, ny = r.y1 - r.y0;
+    const double theta = kPiD * 0.5 * (r.y0 + r.y1) / height;
+    const double wide = nx * kTwoPiD / width * std::sin(theta), tall = ny * kPiD / height;
+    const bool along_x = nx >= 2 && (wide >= tall || ny < 2);
+    if (!along_x && ny < 2) return false;
+    const int lo = (along_x ? r.x0 : r.y0) + 1, hi = (along_x ? r.x1 : r.y1) - 1;
+    auto below = [&](int k) { return along_x ? sat.rect(r.x0, r.y0, k, r.y1) : sat.rect(r.x0, r.y0, r.x1, k); };
+    // First boundary whose lower part holds half the energy, or the one before it if closer.
+    const double half = 0.5 * r.energy;
+    int first = lo, last = hi;
+    while (first < last) {
+        const int mid = first + (last - first) / 2;
+        if (below(mid) >= half) last = mid; else first = mid + 1;
+    }
+    int k = first;
+    if (k > lo && std::fabs(below(k - 1) - half) <= std::fabs(below(k) - half)) --k;
+    a = r, b = r;
+    (along_x ? a.x1 : a.y1) = k;
+    (along_x ? b.x0 : b.y0) = k;
+    a.energy = sat.rect(a.x0, a.y0, a.x1, a.y1);
+    b.energy = sat.rect(b.x0, b.y0, b.x1, b.y1);
+    return true;
+}
+
+/// Median cut of the energy in `sat` into at most n regions: whole rounds of Debevec's cut while
+/// they fit in n, then the most energetic region next; regions without energy are never cut.
+std::vector<Region> median_cut(const SummedArea& sat, int width, int height, int n) {
+    std::vector<Region> regions;
+    Region all{0, 0, width, height, sat.rect(0, 0, width, height), true};
+    if (!(all.energy > 0) || n < 1) return regions;
+    regions.push_back(all);
+    auto cut = [&](Region& r, std::vector<Region>& out) {
+        Region a, b;
+        if (r.energy > 0 && r.splittable && cut_region(r, sat, width, height, a, b)) {
+            out.push_back(a);
+            out.push_back(b);
+            return true;
+        }
+        r.splittable = false;
+        out.push_back(r);
+        return false;
+    };
+    // Whole rounds: every region cut once.
+    while (regions.size() * 2 <= size_t(n)) {
+        std::vector<Region> next;
+        bool progress = false;
+        for (Region& r : regions) progress = cut(r, next) || progress;
+        regions = std::move(next);
+        if (!progress) break;
+    }
+    // Then the most energetic region that can still be cut (the first of equals).
+    while (regions.size() < size_t(n)) {
+        size_t best = regions.size();
+        for (size_t i = 0; i < regions.size(); ++i)
+            if (regions[i].splittable && regions[i].energy > 0 && (best == regions.size() || regions[i].energy > regions[best].energy))
+                best = i;
+        if (best == regions.size()) break;
+        std::vector<Region> two;
+        if (cut(regions[best], two) && two.size() == 2) {
+            regions[best] = two[0];
+            regions.insert(regions.begin() + std::ptrdiff_t(best) + 1, two[1]);
+        } else {
+            regions[best].splittable = false;
+        }
+    }
+    return regions;
+}
+
+/// Orthonormal tangents of unit n (Duff et al. 2017, branchless).
+void tangent_frame(const Vec3f& n, Vec3f& t, Vec3f& b) {
+    const float sign = std::copysign(1.f, n.z);
+    const float a = -1.f / (sign + n.z);
+    const float c = n.x * n.y * a;
+    t = {1.f + sign * n.x * n.x * a, sign * c, -sign * n.x};
+    b = {c, sign + n.y * n.y * a, -n.y};
+}
+
+}  // namespace
+
+// ---- lat-long parameterisation ----------------------------------------------------------------
+
+Vec2f latlong_uv(const Vec3f& d) {
+    const float len = length(d);
+    if (!(len > 0.f) || !std::isfinite(len)) return {0.5f, 0.5f};
+    const float u = 0.5f + std::atan2(d.z, d.x) / (2.f * kPi);
+    const float v = std::acos(std::clamp(d.y / len, -1.f, 1.f)) / kPi;
+    return {std::clamp(u, 0.f, 1.f), std::clamp(v, 0.f, 1.f)};
+}
+
+Vec3f latlong_direction(float u, float v) {
+    const float theta = v * kPi, phi = (u - 0.5f) * 2.f * kPi;
+    return {std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi)};
+}
+
+Color EnvironmentMap::Level::bilinear(float u, float v) const {
+    if (!std::isfinite(u)) u = 0.5f;
+    if (!std::isfinite(v)) v = 0.5f;
+    // Columns wrap around the seam at u = 0 = 1.
+    const float x = u * float(width) - 0.5f;
+    const float fx0 = std::floor(x);
+    const float fx = x - fx0;
+    const int xa = ((int(fx0) % width) + width) % width, xb = (xa + 1) % width;
+    auto row = [&](int y) {
+        const Color* r = &texels[size_t(y) * size_t(width)];
+        return lerp(r[xa], r[xb], fx);
+    };
+    // Rows: within half a texel of a pole, blend into the pole's mean (the same for every u).
+    const float y = std::clamp(v, 0.f, 1.f) * float(height) - 0.5f;
+    if (y < 0.f) return lerp(pole_top, row(0), std::clamp(2.f * (y + 0.5f), 0.f, 1.f));
+    if (y > float(height - 1)) return lerp(row(height - 1), pole_bottom, std::clamp(2.f * (y - float(height - 1)), 0.f, 1.f));
+    const int y0 = std::min(int(y), height - 1), y1 = std::min(y0 + 1, height - 1);
+    return lerp(row(y0), row(y1), y - float(y0));
+}
+
+// ---- SH9 ----------------------------------------------------------------------------------------
+
+std::array<float, 9> sh9_basis(const Vec3f& d) {
+    return {0.282094792f,
+            0.488602512f * d.y,
+            0.488602512f * d.z,
+            0.488602512f * d.x,
+            1.092548431f * d.x * d.y,
+            1.092548431f * d.y * d.z,
+            0.315391565f * (3.f * d.z * d.z - 1.f),
+            1.092548431f * d.x * d.z,
+            0.546274215f * (d.x * d.x - d.y * d.y)};
+}
+
+Color sh9_irradiance(const SH9& sh, const Vec3f& n) {
+    // Ramamoorthi & Hanrahan (2001): E(n) = sum_lm A_l L_lm Y_lm(n), A = (pi, 2pi/3, pi/4); / pi.
+    constexpr std::array<float, 9> a_over_pi{1.f, 2.f / 3.f, 2.f / 3.f, 2.f / 3.f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f};
+    const std::array<float, 9> y = sh9_basis(n);
+    Color e(0.f);
+    for (size_t i = 0; i < 9; ++i) e += sh[i] * (a_over_pi[i] * y[i]);
+    return vmax(e, Color(0.f));
+}
+
+Color EnvironmentLighting::irradiance(const Vec3f& n) const {
+    Color e = residual_irradiance(n);
+    for (const ExtractedLight& l : lights) e += l.intensity * std::max(0.f, dot(n, l.direction));
+    return e;
+}
+
+Light to_directional_light(const ExtractedLight& light, const std::string& name) {
+    Light out;
+    out.name = name;
+    out.type = LightType::Directional;
+    const float peak = max_component(light.intensity);
+    out.intensity = peak;
+    out.color = peak > 0.f ? light.intensity / peak : Color(0.f);
+    out.direction = Vec3d(-light.direction);
+    out.attenuation = Attenuation::None;
+    return out;
+}
+
+// ---- the map ----------------------------------------------------------------------------------
+
+EnvironmentMap::EnvironmentMap(const Environment& env, int threads) {
+    if (!env.image || env.image->width < 1 || env.image->height < 1 ||
+        env.image->texels.size() != size_t(env.image->width) * size_t(env.image->height))
+        throw Error(fmt::format("environment map '{}' has no texels", env.image ? env.image->name : std::string()));
+    const ScopedFlushDenormals ftz;  // the same arithmetic whatever mode the caller runs in
+    const EnvironmentImage& image = *env.image;
+    m_name = image.name;
+    m_visible = env.visible;
+    const double angle = double(env.rotation_deg) * kPiD / 180.0;
+    m_cos = float(std::cos(angle));
+    m_sin = float(std::sin(angle));
+
+    // Level 0: the image at its exposure; negative and non-finite texels count as black.
+    const float scale = std::exp2(env.exposure_stops);
+    Level base;
+    base.width = image.width;
+    base.height = image.height;
+    base.texels.resize(image.texels.size());
+    for (size_t i = 0; i < image.texels.size(); ++i) {
+        const Color c = image.texels[i] * scale;
+        base.texels[i] = {std::isfinite(c.x) ? std::max(c.x, 0.f) : 0.f, std::isfinite(c.y) ? std::max(c.y, 0.f) : 0.f,
+                          std::isfinite(c.z) ? std::max(c.z, 0.f) : 0.f};
+    }
+    set_poles(base);
+    m_texel_angle = float(std::max(kTwoPiD / base.width, kPiD / base.height));
+
+    // Solid-angle weighted mean radiance.
+    Vec3d sum(0.0);
+    for (int y = 0; y < base.height; ++y) {
+        Vec3d row(0.0);
+        for (int x = 0; x < base.width; ++x) row += Vec3d(base.texels[size_t(y) * size_t(base.width) + size_t(x)]);
+        sum += row * texel_solid_angle(y, base.width, base.height);
+    }
+    m_mean = Color(sum / (4.0 * kPiD));
+
+    // MIP pyramid down to 1 x 1.
+    m_levels.push_back(std::move(base));
+    while (m_levels.back().width > 1 || m_levels.back().height > 1) m_levels.push_back(downsample(m_levels.back()));
+
+    // GGX prefilter by filtered importance sampling (Krivanek & Colbert 2008): a fixed Hammersley
+    // set per texel, each sample read from the MIP level whose texel matches its solid angle.
+    const double texel_sr = 4.0 * kPiD / (double(width()) * double(height()));
+    struct Row {
+        size_t level;
+        int y;
+    };
+    std::vector<Row> rows;
+    for (size_t k = 0; k < kPrefilterRoughness.size(); ++k) {
+        Level level;
+        level.width = kPrefilterWidth[k];
+        level.height = kPrefilterWidth[k] / 2;
+        level.texels.resize(size_t(level.width) * size_t(level.height));
+        for (int y = 0; y < level.height; ++y) rows.push_back({k, y});
+        m_prefiltered.push_back(std::move(level));
+    }
+    WorkerPool pool(threads);
+    pool.for_each(rows.size(), [&](size_t item, int) {
+        Level& level = m_prefiltered[rows[item].level];
+        const float alpha = kPrefilterRoughness[rows[item].level] * kPrefilterRoughness[rows[item].level];
+        const float a2 = alpha * alpha;
+        const int y = rows[item].y;
+        for (int x = 0; x < level.width; ++x) {
+            const Vec3f n = latlong_direction((float(x) + 0.5f) / float(level.width), (float(y) + 0.5f) / float(level.height));
+            Vec3f t, b;
+            tangent_frame(n, t, b);
+            Color sum(0.f);
+            float weight = 0.f;
+            for (int s = 0; s < kPrefilterSamples; ++s) {
+                // GGX half vector (normal = view = n), its reflection l, pdf(l) = D(h) / 4.
+                const float xi1 = (float(s) + 0.5f) / float(kPrefilterSamples), xi2 = radical_inverse2(uint32_t(s));
+                const float cos2 = (1.f - xi1) / (1.f + (a2 - 1.f) * xi1);
+                const float cos_h = std::sqrt(cos2), sin_h = std::sqrt(std::max(0.f, 1.f - cos2));
+                const float phi = 2.f * kPi * xi2;
+                const Vec3f h = t * (sin_h * std::cos(phi)) + b * (sin_h * std::sin(phi)) + n * cos_h;
+                const Vec3f l = h * (2.f * cos_h) - n;
+                const float n_dot_l = dot(n, l);
+                if (n_dot_l <= 0.f) continue;
+                const float denom = cos2 * (a2 - 1.f) + 1.f;
+                const float pdf = a2 / (kPi * denom * denom) * 0.25f;
+                const float sample_sr = 1.f / (float(kPrefilterSamples) * pdf);
+                const float lod = std::max(0.f, 0.5f * std::log2(sample_sr / float(texel_sr)) + 1.f);
+                sum += sample_lod(l, lod) * n_dot_l;
+                weight += n_dot_l;
+            }
+            level.texels[size_t(y) * size_t(level.width) + size_t(x)] = weight > 0.f ? sum / weight : Color(0.f);
+        }
+    });
+    for (Level& level : m_prefiltered) set_poles(level);
+}
+
+Vec3f EnvironmentMap::world_from_map(const Vec3f& d) const {
+    return {m_cos * d.x + m_sin * d.z, d.y, -m_sin * d.x + m_cos * d.z};
+}
+
+Vec3f EnvironmentMap::map_from_world(const Vec3f& d) const {
+    return {m_cos * d.x - m_sin * d.z, d.y, m_sin * d.x + m_cos * d.z};
+}
+
+Color EnvironmentMap::sample_lod(const Vec3f& map_dir, float lod) const {
+    const Vec2f uv = latlong_uv(map_dir);
+    const int last = level_count() - 1;
+    if (!(lod > 0.f)) return m_levels.front().bilinear(uv.x, uv.y);
+    if (lod >= float(last)) return m_levels.back().bilinear(uv.x, uv.y);
+    const int l0 = int(lod);
+    const float f = lod - float(l0);
+    return lerp(m_levels[size_t(l0)].bilinear(uv.x, uv.y), m_levels[size_t(l0) + 1].bilinear(uv.x, uv.y), f);
+}
+
+Color EnvironmentMap::radiance(const Vec3f& dir, float cone_angle) const {
+    if (!is_finite(dir)) return Color(0.f);
+    const float lod = cone_angle > 0.f ? std::log2(cone_angle / m_texel_angle) : 0.f;
+    return sample_lod(map_from_world(dir), lod);
+}
+
+Color EnvironmentMap::prefiltered(const Vec3f& dir, float roughness) const {
+    if (!is_finite(dir)) return Color(0.f);
+    const Vec3f d = map_from_world(dir);
+    const Vec2f uv = latlong_uv(d);
+    const float r = std::isfinite(roughness) ? std::clamp(roughness, 0.f, 1.f) : 1.f;
+    if (r <= kPrefilterRoughness.front())
+        return lerp(sample_lod(d, 0.f), m_prefiltered.front().bilinear(uv.x, uv.y), r / kPrefilterRoughness.front());
+    size_t k = 1;
+    while (k + 1 < kPrefilterRoughness.size() && r > kPrefilterRoughness[k]) ++k;
+    const float f = (r - kPrefilterRoughness[k - 1]) / (kPrefilterRoughness[k] - kPrefilterRoughness[k - 1]);
+    return lerp(m_prefiltered[k - 1].bilinear(uv.x, uv.y), m_prefiltered[k].bilinear(uv.x, uv.y), std::clamp(f, 0.f, 1.f));
+}
+
+float split_threshold_factor(int n_lights) {
+    return n_lights > 0 ? std::max(2.f / std::sqrt(float(n_lights)), 1.f / 16.f) : 2.f;
+}
+
+EnvironmentLighting EnvironmentMap::split(const SplitSettings& settings) const {
+    const ScopedFlushDenormals ftz;
+    const Level& base = m_levels.front();
+    const int w = base.width, h = base.height;
+    EnvironmentLighting out;
+    const bool extract = settings.lights > 0;
+    const float factor = settings.threshold_factor > 0.f ? settings.threshold_factor : split_threshold_factor(settings.lights);
+    // Never below the dimmest texel: light common to every direction is a constant, which the
+    // ambient holds exactly and point lights only approximate (a uniform map stays all ambient).
+    double dimmest = kInfinity;
+    for (const Color& c : base.texels) dimmest = std::min(dimmest, luminance(c));
+    out.threshold = extract ? float(std::max(factor * luminance(m_mean), dimmest)) : kInfinity;
+    const double threshold = out.threshold;
+
+    // Per texel: the excess over the threshold (hue kept) to the extracted map, the rest to the
+    // residual. Both are projected on SH9 (solid-angle weighted, texel-centre directions, world
+    // space); the extracted one only to correct the lights' error below.
+    std::vector<Color> extracted(extract ? base.texels.size() : 0);
+    SummedArea energy(extract ? w : 0, extract ? h : 0);
+    std::array<Vec3d, 9> residual_sh{}, extracted_sh{};
+    Vec3d residual_power(0.0);
+    std::vector<double> row_energy(static_cast<size_t>(w));
+    const TexelGrid grid(w, h);
+    for (int y = 0; y < h; ++y) {
+        const double sr = grid.solid_angle(y);
+        std::array<Vec3d, 9> row_residual{}, row_extracted{};
+        Vec3d row_power(0.0);
+        for (int x = 0; x < w; ++x) {
+            const size_t i = size_t(y) * size_t(w) + size_t(x);
+            const Color c = base.texels[i];
+            const double lum = luminance(c);
+            Color residual = c;
+            const std::array<float, 9> basis = sh9_basis(world_from_map(Vec3f(grid.direction(x, y))));
+            if (extract && lum > threshold) {
+                residual = c * float(threshold / lum);
+                extracted[i] = c - residual;
+                for (size_t k = 0; k < 9; ++k) row_extracted[k] += Vec3d(extracted[i]) * double(basis[k]);
+            }
+            if (extract) row_energy[size_t(x)] = luminance(extracted[i]) * sr;
+            for (size_t k = 0; k < 9; ++k) row_residual[k] += Vec3d(residual) * double(basis[k]);
+            row_power += Vec3d(residual);
+        }
+        for (size_t k = 0; k < 9; ++k) residual_sh[k] += row_residual[k] * sr, extracted_sh[k] += row_extracted[k] * sr;
+        residual_power += row_power * sr;
+        if (extract) energy.set_row(y, row_energy);
+    }
+    out.residual_power = Color(residual_power);
+
+    // Debevec's median cut of the extracted energy; each region becomes one light at its energy
+    // centroid carrying its power / pi (a Lambertian of albedo kd then receives kd (N.L) I).
+    Vec3d extracted_power(0.0);
+    const std::vector<Region> regions = extract ? median_cut(energy, w, h, settings.lights) : std::vector<Region>{};
+    for (const Region& r : regions) {
+        Vec3d power(0.0), centroid(0.0);
+        double sr_total = 0;
+        for (int y = r.y0; y < r.y1; ++y) {
+            const double sr = grid.solid_angle(y);
+            Vec3d row_power(0.0), row_centroid(0.0);
+            for (int x = r.x0; x < r.x1; ++x) {
+                const Color e = extracted[size_t(y) * size_t(w) + size_t(x)];
+                row_power += Vec3d(e);
+                row_centroid += grid.direction(x, y) * luminance(e);
+            }
+            power += row_power * sr;
+            centroid += row_centroid * sr;
+            sr_total += sr * (r.x1 - r.x0);
+        }
+        if (!(power.x > 0 || power.y > 0 || power.z > 0)) continue;
+        ExtractedLight light;
+        const Vec3d mid = grid.direction((r.x0 + r.x1) / 2, (r.y0 + r.y1) / 2);
+        light.direction = world_from_map(normalize(Vec3f(length(centroid) > 0 ? centroid : mid)));
+        light.intensity = Color(power / kPiD);
+        light.solid_angle = float(sr_total);
+        light.x0 = r.x0, light.y0 = r.y0, light.x1 = r.x1, light.y1 = r.y1;
+        out.lights.push_back(light);
+        extracted_power += power;
+    }
+    out.extracted_power = Color(extracted_power);
+    std::stable_sort(out.lights.begin(), out.lights.end(), [](const ExtractedLight& a, const ExtractedLight& b) {
+        return luminance(a.intensity) > luminance(b.intensity);
+    });
+
+    // A light stands for its region only approximately; in bands 0-2 the difference between
+    // the region and its light is known (the extracted projection minus the light's, a delta
+    // of its power at its direction), so the ambient absorbs it. Band 0 cancels exactly.
+    if (settings.correct_ambient)
+        for (const ExtractedLight& l : out.lights) {
+            const std::array<float, 9> basis = sh9_basis(l.direction);
+            for (size_t k = 0; k < 9; ++k) extracted_sh[k] -= Vec3d(l.intensity) * (kPiD * double(basis[k]));
+        }
+    for (size_t k = 0; k < 9; ++k)
+        out.residual_sh[k] = Color(settings.correct_ambient && k > 0 ? residual_sh[k] + extracted_sh[k] : residual_sh[k]);
+    return out;
+}
+
+Color EnvironmentMap::brute_force_irradiance(const Vec3f& n) const {
+    const Level& base = m_levels.front();
+    const Vec3d normal(map_from_world(n));
+    const TexelGrid grid(base.width, base.height);
+    Vec3d sum(0.0);
+    for (int y = 0; y < base.height; ++y) {
+        Vec3d row(0.0);
+        for (int x = 0; x < base.width; ++x) {
+            const double c = dot(normal, grid.direction(x, y));
+            if (c > 0) row += Vec3d(base.texels[size_t(y) * size_t(base.width) + size_t(x)]) * c;
+        }
+        sum += row * grid.solid_angle(y);
+    }
+    return Color(sum / kPiD);
+}
+
+size_t EnvironmentMap::bytes() const {
+    size_t total = sizeof(*this);
+    for (const Level& l : m_levels) total += l.texels.size() * sizeof(Color);
+    for (const Level& l : m_prefiltered) total += l.texels.size() * sizeof(Color);
+    return total;
+}
+
+size_t EnvironmentMap::estimated_bytes(int width, int height) {
+    size_t w = size_t(std::max(width, 1)), h = size_t(std::max(height, 1));
+    const size_t base = w * h;
+    // split(): the extracted texels and the summed-area table of their energy.
+    size_t total = sizeof(EnvironmentMap) + base * sizeof(Color) + (w + 1) * (h + 1) * sizeof(double);
+    // The pyramid, level 0 included.
+    for (;;) {
+        total += w * h * sizeof(Color);
+        if (w == 1 && h == 1) break;
+        w = std::max<size_t>(1, w / 2), h = std::max<size_t>(1, h / 2);
+    }
+    for (int pw : kPrefilterWidth) total += size_t(pw) * size_t(pw / 2) * sizeof(Color);
+    return total;
+}
+
+}  // namespace whitted

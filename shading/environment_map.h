@@ -1,0 +1,163 @@
+// The environment as the renderer uses it: filtered radiance for rays that leave the scene,
+// its light split into directional lights plus a spherical-harmonic ambient, and a GGX
+// prefiltered copy for rough reflections. Built once from an Environment; every query is const
+// and pure, so any number of threads may share one map.
+//
+// Axis convention (docs/environment.md): +Y up; a map-local direction d has
+//   u = 0.5 + atan2(d.z, d.x) / (2 pi),  v = acos(d.y) / pi
+// so the image's centre column looks toward +X, u = 0.25 toward -Z, u = 0.75 toward +Z, and
+// row 0 is the +Y pole (glTF Sample Viewer, three.js and Blender agree). The map is turned about
+// +Y by rotation_deg (right-hand rule): world = R_y(rotation) * map-local.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "renderer/core/vecmath.h"
+#include "renderer/scene/environment.h"
+#include "renderer/scene/scene.h"
+
+namespace whitted {
+
+/// Number of extracted lights when the caller does not choose: the fewest of the measured
+/// counts whose irradiance at the 6 axis normals is within 2 % of the map's for the bundled
+/// studio and courtyard maps (docs/measurements/environment.md).
+constexpr int kDefaultEnvironmentLights = 128;
+/// Roughness of the stored prefiltered levels; roughness 0 is the map itself.
+constexpr std::array<float, 4> kPrefilterRoughness{0.25f, 0.5f, 0.75f, 1.f};
+
+/// Real spherical-harmonic coefficients of bands 0..2 (Ramamoorthi & Hanrahan 2001 order:
+/// L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22), one RGB value each.
+using SH9 = std::array<Color, 9>;
+
+/// The 9 real SH basis functions at the unit direction d.
+std::array<float, 9> sh9_basis(const Vec3f& d);
+
+/// Irradiance from radiance SH coefficients at unit normal n, divided by pi (renderer units:
+/// a constant radiance L gives L), with Ramamoorthi & Hanrahan's cosine-lobe constants
+/// A0 = pi, A1 = 2pi/3, A2 = pi/4; clamped at 0.
+Color sh9_irradiance(const SH9& sh, const Vec3f& n);
+
+/// One light cut from the environment's brightest part (one median-cut region).
+struct ExtractedLight {
+    Vec3f direction{0.f, 1.f, 0.f};   ///< unit, world space, toward the light: the region's energy centroid
+    Color intensity{0.f};             ///< renderer units (lux): the region's extracted power (integral of L dw) / pi
+    float solid_angle = 0.f;          ///< of the region, steradians
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  ///< the region in level-0 texels, [x0, x1) x [y0, y1)
+};
+
+/// The environment's light in two deterministic parts whose sum is the map's irradiance:
+/// sum_k intensity_k * max(0, N.d_k) + residual_irradiance(N).
+struct EnvironmentLighting {
+    std::vector<ExtractedLight> lights;  ///< brightest regions, most powerful first
+    SH9 residual_sh{};                ///< the ambient as radiance SH (world space): the residual's projection, plus
+                                      ///< (correct_ambient) the extracted regions' projection minus their lights'
+                                      ///< in bands 1-2 (band 0 of that difference is 0: each light keeps its power)
+    float threshold = kInfinity;      ///< luminance above which texels were extracted (infinite: none)
+    Color extracted_power{0.f};       ///< sum of the lights' integral of L dw
+    Color residual_power{0.f};        ///< integral of the residual's L dw
+
+    /// Ambient irradiance at unit normal n, renderer units (sh9_irradiance of residual_sh).
+    Color residual_irradiance(const Vec3f& n) const { return sh9_irradiance(residual_sh, n); }
+    /// Irradiance of lights and residual together at unit normal n, renderer units.
+    Color irradiance(const Vec3f& n) const;
+};
+
+/// How EnvironmentMap::split() divides the light.
+struct SplitSettings {
+    int lights = kDefaultEnvironmentLights;  ///< at most this many extracted lights; 0 = everything is ambient
+    float threshold_factor = 0.f;            ///< threshold T = max(factor * mean luminance, dimmest texel's); 0 = split_threshold_factor(lights)
+    bool correct_ambient = true;             ///< the ambient's bands 1-2 absorb the lights' own error in those bands
+};
+
+/// The threshold factor split() uses by default: 2 / sqrt(n_lights), at least 1/16 (T falls
+/// as the lights get finer; docs/environment.md "How the light is split").
+float split_threshold_factor(int n_lights);
+
+/// A directional Light for an extracted light: travel direction -direction, colour
+/// intensity / max component, intensity its max component, no attenuation.
+Light to_directional_light(const ExtractedLight& light, const std::string& name);
+
+class EnvironmentMap {
+public:
+    /// Applies 2^exposure_stops, builds the MIP pyramid and the prefiltered levels on `threads`
+    /// worker threads (0 = all hardware threads; the result is the same for any count).
+    /// Throws whitted::Error when env.image is null or empty.
+    explicit EnvironmentMap(const Environment& env, int threads = 0);
+
+    /// Radiance arriving from world direction `dir` (any length; non-finite gives 0), filtered
+    /// over a cone of full apex angle `cone_angle` radians: trilinear between MIP levels of the
+    /// lat-long, bilinear within one (wrap in u; rows blend into the pole's mean at v = 0 and 1).
+    Color radiance(const Vec3f& dir, float cone_angle = 0.f) const;
+
+    /// The map convolved with a GGX lobe of roughness `roughness` (alpha = roughness^2) about
+    /// `dir`, normal = view = reflection direction (the split-sum prefilter); between the stored
+    /// levels (kPrefilterRoughness) linear in roughness, below the first toward radiance(dir).
+    Color prefiltered(const Vec3f& dir, float roughness) const;
+
+    /// Splits the map's light into at most settings.lights extracted lights plus the SH ambient
+    /// (0 lights: everything is ambient). Texels whose luminance exceeds the threshold T give
+    /// texel * (1 - T / lum) to the lights, cut by Debevec's (2005) median cut; the rest is the
+    /// residual. Deterministic; costs a summed-area table of the map (estimated_bytes).
+    EnvironmentLighting split(const SplitSettings& settings) const;
+    /// split() with n_lights lights and the default threshold.
+    EnvironmentLighting split(int n_lights) const {
+        SplitSettings settings;
+        settings.lights = n_lights;
+        return split(settings);
+    }
+
+    /// Irradiance at unit normal n by summing every level-0 texel, divided by pi (the reference
+    /// the split is measured against; O(width * height)).
+    Color brute_force_irradiance(const Vec3f& n) const;
+
+    /// Solid-angle weighted mean radiance of the map (exposure applied).
+    Color mean() const { return m_mean; }
+    /// Level-0 size in texels.
+    int width() const { return m_levels.front().width; }
+    int height() const { return m_levels.front().height; }
+    /// MIP levels, level 0 = full resolution, the last 1 x 1.
+    int level_count() const { return int(m_levels.size()); }
+    /// Whether camera rays that miss see the map (Environment::visible).
+    bool visible() const { return m_visible; }
+    /// Name of the image (Environment::image->name).
+    const std::string& name() const { return m_name; }
+    /// World direction from map-local and back (rotation about +Y).
+    Vec3f world_from_map(const Vec3f& d) const;
+    Vec3f map_from_world(const Vec3f& d) const;
+
+    /// Bytes this map holds (MIP pyramid and prefiltered levels).
+    size_t bytes() const;
+    /// Upper bound on the bytes a map of width x height holds at its peak: the pyramid, the
+    /// prefiltered levels and split()'s temporaries (extracted texels, summed-area table).
+    static size_t estimated_bytes(int width, int height);
+
+    /// One lat-long level: linear RGB texels, row 0 at +Y, and the mean of each pole row.
+    struct Level {
+        int width = 0, height = 0;
+        std::vector<Color> texels;
+        Color pole_top{0.f}, pole_bottom{0.f};  ///< mean of row 0 and of the last row: the value at v = 0 and v = 1
+        /// Bilinear at (u, v) in [0, 1]^2: wrap in u; within half a texel of a pole, blend into the pole's mean.
+        Color bilinear(float u, float v) const;
+    };
+
+private:
+    Color sample_lod(const Vec3f& map_dir, float lod) const;
+
+    std::vector<Level> m_levels;      ///< MIP pyramid of the lat-long (map-local)
+    std::vector<Level> m_prefiltered; ///< one per kPrefilterRoughness (map-local)
+    Color m_mean{0.f};
+    float m_texel_angle = 0.f;        ///< angular size of a level-0 texel, radians
+    float m_cos = 1.f, m_sin = 0.f;   ///< of the rotation about +Y
+    bool m_visible = true;
+    std::string m_name;
+};
+
+/// Map-local direction -> (u, v) of the lat-long, both in [0, 1]; finite for every unit d.
+Vec2f latlong_uv(const Vec3f& d);
+/// (u, v) -> unit map-local direction.
+Vec3f latlong_direction(float u, float v);
+
+}  // namespace whitted
