@@ -29,6 +29,21 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Timings are asserted only in optimised builds without sanitizers (those run several times slower).
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define WHITTED_TEST_INSTRUMENTED 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || !defined(__OPTIMIZE__)
+#define WHITTED_TEST_INSTRUMENTED 1
+#endif
+#ifdef WHITTED_TEST_INSTRUMENTED
+constexpr bool kTimingsAsserted = false;
+#else
+constexpr bool kTimingsAsserted = true;
+#endif
+
 /// A w x h environment whose texel (x, y) is texel(x, y).
 Environment make_environment(int w, int h, const std::function<Color(int, int)>& texel, float rotation_deg = 0.f) {
     auto image = std::make_shared<EnvironmentImage>();
@@ -383,7 +398,9 @@ TEST(Environment, BuildCostAndMemory) {
     std::printf("[ cost ] 1024x512 map on one thread: build %.0f ms, split(%d) %.0f ms, %zu bytes (estimate %zu)\n",
                 1e3 * build, kDefaultEnvironmentLights, 1e3 * split, map.bytes(),
                 EnvironmentMap::estimated_bytes(map.width(), map.height()));
-    EXPECT_LT(build + split, 1.0);  // thread CPU time: other processes on the machine do not count
+    if (kTimingsAsserted) {
+        EXPECT_LT(build + split, 1.0);  // thread CPU time: other processes do not count
+    }
     EXPECT_LE(map.bytes(), EnvironmentMap::estimated_bytes(map.width(), map.height()));
     EXPECT_GT(map.bytes(), size_t(1024 * 512 * 12));
 }
