@@ -11,19 +11,13 @@
 #include <fmt/ranges.h>
 
 #include "importers/image_decode.h"
+#include "importers/one_line.h"
 #include "renderer/core/error.h"
 #include "shading/environment_map.h"
 
 namespace whitted {
 
 namespace {
-
-std::string one_line(std::string s) {
-    for (char& c : s)
-        if ((unsigned char)c < 0x20 || c == 0x7f) c = ' ';
-    while (!s.empty() && s.back() == ' ') s.pop_back();
-    return s;
-}
 
 /// sRGB transfer -> linear (IEC 61966-2-1) for a value in [0, 1].
 float srgb_to_linear(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }

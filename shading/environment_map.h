@@ -48,7 +48,7 @@ struct ExtractedLight {
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  ///< the region in level-0 texels, [x0, x1) x [y0, y1)
 };
 
-/// The environment's light in two deterministic parts whose sum is the map's irradiance:
+/// The environment's light in two deterministic parts whose sum approximates the map's irradiance:
 /// sum_k intensity_k * max(0, N.d_k) + residual_irradiance(N).
 struct EnvironmentLighting {
     std::vector<ExtractedLight> lights;  ///< brightest regions, most powerful first
