@@ -26,7 +26,8 @@ struct ImportOptions {
     std::optional<float> environment_rotation;  ///< degrees about +Y; unset = the scene file's (or 0)
     std::optional<float> environment_exposure;  ///< stops; unset = the scene file's (or 0)
     bool no_environment = false;                ///< no environment at all, whatever the file says
-    int environment_lights = 16;                ///< lights extracted from it (0 = all of its light is ambient)
+    int environment_lights = 16;                ///< lights extracted from it (0 = all of its light is ambient);
+                                                ///< = kDefaultEnvironmentLights (shading/environment_map.h)
 };
 
 /// Sets up the scene's environment after import: the one `options` names replaces the file's

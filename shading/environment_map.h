@@ -21,10 +21,11 @@
 
 namespace whitted {
 
-/// Number of extracted lights when the caller does not choose: the fewest of the measured
-/// counts whose irradiance at the 6 axis normals is within 2 % of the map's for the bundled
-/// studio and courtyard maps (docs/measurements/environment.md).
-constexpr int kDefaultEnvironmentLights = 128;
+/// Number of extracted lights when the caller does not choose (ImportOptions::environment_lights,
+/// --env-lights): each costs a shadow ray per shaded point. At 16 the lights plus the ambient give
+/// the map's irradiance within 6-7 % at the 6 axis normals of studio and courtyard (2 % needs 128:
+/// docs/measurements/environment.md); `whitted bench env` measures the image error per count.
+constexpr int kDefaultEnvironmentLights = 16;
 /// Roughness of the stored prefiltered levels; roughness 0 is the map itself.
 constexpr std::array<float, 4> kPrefilterRoughness{0.25f, 0.5f, 0.75f, 1.f};
 
