@@ -38,6 +38,12 @@ std::string resolve_environment_name(const std::string& name) {
     throw Error(fmt::format("environment '{}': no such file, and not a bundled name ({})", name, fmt::join(names, ", ")));
 }
 
+bool is_bundled_environment(const std::string& path) {
+    for (const std::string& name : bundled_environment_names())
+        if (path == std::string(WHITTED_SOURCE_DIR) + "/assets/environments/" + name + ".exr") return true;
+    return false;
+}
+
 size_t environment_load_bytes(int width, int height, int channels) {
     const size_t texels = size_t(std::max(width, 0)) * size_t(std::max(height, 0));
     return texels * size_t(std::max(channels, 1)) * sizeof(float) + texels * sizeof(Color) +

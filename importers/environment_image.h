@@ -18,6 +18,10 @@ const std::vector<std::string>& bundled_environment_names();
 /// the bundled names.
 std::string resolve_environment_name(const std::string& name);
 
+/// True when `path` is one of the bundled maps (resolve_environment_name of a bundled name). Their
+/// few slightly negative texels are reported at info level, not as a warning of every render.
+bool is_bundled_environment(const std::string& path);
+
 /// Bytes loading and using a width x height map with `channels` channels costs at its peak:
 /// the file's float pixels, the image (12 bytes a texel) and EnvironmentMap::estimated_bytes.
 size_t environment_load_bytes(int width, int height, int channels);

@@ -28,7 +28,9 @@ void setup_environment(Scene& scene, const ImportOptions& options) {
         std::vector<std::string> warnings;
         const std::string path = resolve_environment_name(options.environment);
         auto image = std::make_shared<EnvironmentImage>(load_environment_image(path, options.max_memory, warnings));
-        for (const std::string& w : warnings) add_warning(scene, w);
+        for (const std::string& w : warnings)
+            if (is_bundled_environment(path)) log_info("{}", w);
+            else add_warning(scene, w);
         Environment env;
         env.image = std::move(image);
         scene.environment = std::move(env);

@@ -33,6 +33,7 @@
 #include "importers/scene_file_image.h"
 #include "importers/scene_file_json.h"
 #include "importers/warning_log.h"
+#include "renderer/core/log.h"
 #include "renderer/core/error.h"
 #include "shading/texture_sampling.h"
 
@@ -1102,13 +1103,16 @@ private:
         std::error_code ec;
         const std::string where = fs::exists(path, ec) ? path.lexically_normal().string() : file;
         std::vector<std::string> warnings;
+        std::string resolved;
         try {
-            env.image = std::make_shared<EnvironmentImage>(
-                load_environment_image(resolve_environment_name(where), m_options.max_memory, warnings));
+            resolved = resolve_environment_name(where);
+            env.image = std::make_shared<EnvironmentImage>(load_environment_image(resolved, m_options.max_memory, warnings));
         } catch (const Error& e) {
             fail(v.is_string() ? p : sub(p, "file"), "{}", e.what());
         }
-        for (const std::string& w : warnings) m_scene.warn(w);
+        for (const std::string& w : warnings)
+            if (is_bundled_environment(resolved)) log_info("{}", w);
+            else m_scene.warn(w);
         m_scene.environment = std::move(env);
     }
 

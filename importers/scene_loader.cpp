@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "importers/environment_image.h"
 #include "importers/located_error.h"
 #include "importers/scene_file.h"
 #include "renderer/core/error.h"
+#include "renderer/core/log.h"
 
 namespace whitted {
 
@@ -21,6 +23,19 @@ Scene load_scene(const std::string& path, const ImportOptions& options) {
         throw Error(file_loc(path),
                 ext.empty() ? std::string("file has no extension: cannot tell its format (supported: .gltf, .glb, .json)")
                             : "unsupported scene file extension '" + ext + "' (supported: .gltf, .glb, .json)");
+    // A glTF file with neither lights nor an environment is lit by the bundled studio map, as
+    // glTF viewers do (docs/environment.md); its lights replace the default light.
+    const bool unlit = std::all_of(scene.lights.begin(), scene.lights.end(), [](const Light& l) { return l.is_default; });
+    if (ext != ".json" && unlit && !scene.environment && options.environment.empty() && options.default_environment &&
+        !options.no_environment) {
+        ImportOptions with_studio = options;
+        with_studio.environment = bundled_environment_names().front();
+        log_info("{}: no lights and no environment in the file: lit by the bundled '{}' environment "
+                 "(--no-environment: the default light instead)",
+                 path, with_studio.environment);
+        setup_environment(scene, with_studio);
+        return scene;
+    }
     setup_environment(scene, options);
     return scene;
 }

@@ -26,6 +26,8 @@ struct ImportOptions {
     std::optional<float> environment_rotation;  ///< degrees about +Y; unset = the scene file's (or 0)
     std::optional<float> environment_exposure;  ///< stops; unset = the scene file's (or 0)
     bool no_environment = false;                ///< no environment at all, whatever the file says
+    bool default_environment = true;            ///< a glTF file with no lights and no environment is lit
+                                                ///< by the bundled studio map instead of the default light
     int environment_lights = 16;                ///< lights extracted from it (0 = all of its light is ambient);
                                                 ///< = kDefaultEnvironmentLights (shading/environment_map.h)
 };

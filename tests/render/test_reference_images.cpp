@@ -32,6 +32,8 @@ struct ImageCase {
     int camera = 0;
     bool refract_thin = false;
     bool scene_settings = false;  ///< a scene file: apply its render settings, then the size above
+    bool no_environment = false;  ///< the default light instead of the default studio environment
+    std::string environment;      ///< an environment to light it with (ImportOptions::environment)
 };
 
 std::ostream& operator<<(std::ostream& os, const ImageCase& c) { return os << c.name; }
@@ -54,7 +56,10 @@ OIIO::ImageBuf to_imagebuf(const Film& film) {
 }
 
 Film render_case(const ImageCase& c) {
-    Scene scene = load_scene(std::string(WHITTED_ASSETS_DIR) + "/" + c.asset);
+    ImportOptions io;
+    io.no_environment = c.no_environment;
+    io.environment = c.environment;
+    Scene scene = load_scene(std::string(WHITTED_ASSETS_DIR) + "/" + c.asset, io);
     RenderSettings rs;
     if (c.scene_settings) apply_scene_settings(scene.settings, rs);
     rs.width = c.width;
@@ -105,10 +110,15 @@ TEST_P(ReferenceImages, MatchesReference) {
 
 INSTANTIATE_TEST_SUITE_P(
     RealAssets, ReferenceImages,
-    ::testing::Values(ImageCase{"box", "gltf/Box/glTF-Binary/Box.glb"},
-                      ImageCase{"duck", "gltf/Duck/glTF-Binary/Duck.glb"},
+    ::testing::Values(ImageCase{"box", "gltf/Box/glTF-Binary/Box.glb", 160, 0, 0, false, false, true},
+                      ImageCase{"duck", "gltf/Duck/glTF-Binary/Duck.glb", 160, 0, 0, false, false, true},
+                      ImageCase{"duck_studio", "gltf/Duck/glTF-Binary/Duck.glb"},
+                      ImageCase{"box_courtyard", "gltf/Box/glTF-Binary/Box.glb", 160, 0, 0, false, false, false, "courtyard"},
                       ImageCase{"lamp", "gltf/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf"},
-                      ImageCase{"hurricane", "gltf/GlassHurricaneCandleHolder/glTF-Binary/GlassHurricaneCandleHolder.glb"},
+                      ImageCase{"hurricane", "gltf/GlassHurricaneCandleHolder/glTF-Binary/GlassHurricaneCandleHolder.glb",
+                                160, 0, 0, false, false, true},
+                      ImageCase{"hurricane_studio",
+                                "gltf/GlassHurricaneCandleHolder/glTF-Binary/GlassHurricaneCandleHolder.glb"},
                       ImageCase{"default_scene", "scenes/default.glb"},
                       ImageCase{"whitted1980", "scenes/whitted1980.json", 160, 0, 0, false, true},
                       ImageCase{"transparent_shadows", "scenes/transparent_shadows.json", 160, 0, 0, false, true},

@@ -533,8 +533,38 @@ TEST(GltfImporter, MetalRoughSpheresLoadsQuickly) {
     EXPECT_EQ(spheres, 98u);
 }
 
-TEST(GltfImporter, DefaultCameraAndLight) {
+/// The default light, not the default studio environment (ImportOptions::default_environment).
+ImportOptions default_light_options() {
+    ImportOptions o;
+    o.default_environment = false;
+    return o;
+}
+
+// A glTF file with no lights and no environment is lit by the bundled studio map: its extracted
+// lights replace the default light, and --no-environment (or default_environment = false) and a
+// file with lights keep the old behaviour.
+TEST(GltfImporter, DefaultStudioEnvironment) {
     const Scene s = load_scene(asset("Box/glTF/Box.gltf"));
+    ASSERT_TRUE(s.environment);
+    EXPECT_EQ(s.environment->image->name, "studio");
+    ASSERT_FALSE(s.lights.empty());
+    for (const Light& l : s.lights) {
+        EXPECT_TRUE(l.from_environment);
+        EXPECT_FALSE(l.is_default);
+    }
+    EXPECT_TRUE(s.environment->ambient_sh);
+    ImportOptions none;
+    none.no_environment = true;
+    const Scene plain = load_scene(asset("Box/glTF/Box.gltf"), none);
+    EXPECT_FALSE(plain.environment);
+    ASSERT_EQ(plain.lights.size(), 1u);
+    EXPECT_TRUE(plain.lights[0].is_default);
+    const Scene lit = load_scene(asset("LightsPunctualLamp/glTF/LightsPunctualLamp.gltf"));
+    EXPECT_FALSE(lit.environment);
+}
+
+TEST(GltfImporter, DefaultCameraAndLight) {
+    const Scene s = load_scene(asset("Box/glTF/Box.gltf"), default_light_options());
     ASSERT_EQ(s.cameras.size(), 1u);
     const Camera& c = s.cameras[0];
     EXPECT_TRUE(c.is_default);
@@ -558,7 +588,7 @@ TEST(GltfImporter, DefaultCameraAndLight) {
     EXPECT_EQ(l.attenuation, Attenuation::None);
     EXPECT_VEC3_NEAR(l.direction, 0.4 / std::sqrt(1.52), -1 / std::sqrt(1.52), -0.6 / std::sqrt(1.52), 1e-12);
     EXPECT_TRUE(has_warning(s, "no lights in the file: added the default light (see docs/lights.md)"));
-    ImportOptions o;
+    ImportOptions o = default_light_options();
     o.add_default_camera = false;
     o.add_default_light = false;
     const Scene bare = load_scene(asset("Box/glTF/Box.gltf"), o);

@@ -23,7 +23,9 @@ std::vector<std::string> lines_starting_with(const std::string& text, const std:
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 TEST(SceneReport, CountsCamerasMaterialsAndWarnings) {
-    const Scene s = load_scene(asset("Cameras/glTF/Cameras.gltf"));
+    ImportOptions default_light;
+    default_light.default_environment = false;
+    const Scene s = load_scene(asset("Cameras/glTF/Cameras.gltf"), default_light);
     const std::string text = describe_scene(s);
     EXPECT_EQ(text, describe_scene(s));  // stable
     const auto counts = lines_starting_with(text, "counts: ");
@@ -73,6 +75,26 @@ TEST(SceneReport, TextureTransformIsShown) {
     const Scene s = load_scene(asset("TextureTransformTest/glTF/TextureTransformTest.gltf"), no_textures());
     const std::string text = describe_scene(s);
     EXPECT_TRUE(contains(text, "base_color=tex1(uv0, offset (-0.2, -0.1) rotation 0.3 scale (1.5, 1.5))")) << text;
+}
+
+}  // namespace
+}  // namespace whitted::test
+
+namespace whitted::test {
+namespace {
+
+// `whitted info` of a file lit by an environment says so: its size, its lights, its ambient.
+TEST(SceneReport, EnvironmentLightsAndAmbient) {
+    ImportOptions o;
+    o.environment = "courtyard";
+    o.environment_lights = 4;
+    const std::string text = describe_scene(load_scene(asset("Box/glTF/Box.gltf"), o));
+    const auto env = lines_starting_with(text, "environment: ");
+    ASSERT_EQ(env.size(), 1u) << text;
+    EXPECT_TRUE(contains(env[0], "name=\"courtyard\" size=1024x512 rotation=0 exposure=0 visible=yes lights=4"))
+        << env[0];
+    EXPECT_EQ(lines_starting_with(text, "environment ambient: +X=").size(), 1u);
+    EXPECT_EQ(lines_starting_with(text, "light[3]: name=\"environment light 3\" type=directional").size(), 1u);
 }
 
 }  // namespace
