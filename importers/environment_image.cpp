@@ -30,8 +30,10 @@ const std::vector<std::string>& bundled_environment_names() {
 }
 
 std::string resolve_environment_name(const std::string& name) {
+    // An existing file wins; a folder of the same name (a "studio" folder in the working
+    // directory) does not hide the bundled map.
     std::error_code ec;
-    if (std::filesystem::exists(name, ec)) return name;
+    if (std::filesystem::is_regular_file(name, ec)) return name;
     const auto& names = bundled_environment_names();
     if (std::find(names.begin(), names.end(), name) != names.end())
         return std::string(WHITTED_SOURCE_DIR) + "/assets/environments/" + name + ".exr";

@@ -13,7 +13,7 @@ namespace whitted {
 /// The names of the maps bundled in assets/environments/ (studio first: the default).
 const std::vector<std::string>& bundled_environment_names();
 
-/// A path that exists is returned as is; a bundled name gives
+/// A path to an existing file is returned as is; a bundled name gives
 /// <source tree>/assets/environments/<name>.exr; anything else throws whitted::Error listing
 /// the bundled names.
 std::string resolve_environment_name(const std::string& name);
