@@ -19,6 +19,8 @@ struct Command {
 Command register_bench_aa(CLI::App& bench);
 /// `whitted bench accel`: build time, memory and Mrays/s of every accelerator (bench_accel.cpp).
 Command register_bench_accel(CLI::App& bench);
+/// `whitted bench env`: display error and time of N lights extracted from an environment (bench_env.cpp).
+Command register_bench_env(CLI::App& bench);
 /// `whitted bench skip`: what specialised kernels and skipped rays save (bench_skip.cpp).
 Command register_bench_skip(CLI::App& bench);
 /// `whitted bench stability`: the numerical-stability sweep (bench_stability.cpp).

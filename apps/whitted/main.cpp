@@ -390,6 +390,7 @@ int main(int argc, char** argv) {
     // Each benchmark module registers itself here (one line each; benchmarks/bench_commands.h):
     commands.push_back(app::register_bench_aa(*bench));
     commands.push_back(app::register_bench_accel(*bench));
+    commands.push_back(app::register_bench_env(*bench));
     commands.push_back(app::register_bench_skip(*bench));
     commands.push_back(app::register_bench_stability(*bench));
 

@@ -1,0 +1,390 @@
+// `whitted bench env [ASSETS...]`: how many lights to extract from an environment
+// (docs/environment.md, "whitted bench env").
+//
+// For each asset and map: the asset rendered with N extracted lights for every N of --lights and
+// with the reference N (--reference), each a scene of its own (load_scene with the environment
+// and N, as `whitted render --environment MAP --env-lights N` loads it) on the same settings. Each
+// N reports the RMSE of its display image (the OCIO transform `render` writes PNGs with, clamped to
+// [0, 1]: 1/255 is one 8-bit code) against the reference's, its render time (the median of
+// --repeat runs, interleaved over the Ns; fewer runs once an N has taken 2 s) and its shadow rays.
+// The chosen default is the N of least total time whose RMSE is within 1/255 on every asset and
+// map; the bench names the asset and map that rule out the next cheaper N.
+//
+// Then the cost of the environment's lookups (MIP lat-long for missed rays, SH9 ambient): each
+// bundled scene rendered with the first map and 0 extracted lights against a plain background
+// (no environment), both with the same lights, as a ratio of median times.
+//
+// Writes <out>/env.csv, <out>/env_overhead.csv, a PNG per asset, map and N, and (python3 with
+// matplotlib) the error-against-time plot through scripts/plot_env.py.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "benchmarks/bench_commands.h"
+#include "benchmarks/bench_images.h"
+#include "benchmarks/bench_timing.h"
+#include "importers/scene_loader.h"
+#include "renderer/core/error.h"
+#include "renderer/integrator/render.h"
+#include "renderer/output/image_output.h"
+#include "shading/environment_map.h"
+
+namespace whitted::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// One display code of an 8-bit image: the tolerance the default is chosen by.
+constexpr double kOneCode = 1.0 / 255.0;
+
+struct BenchEnvOptions {
+    std::vector<std::string> assets;                       ///< glTF files; empty = kDefaultAssets
+    std::vector<std::string> maps{"studio", "courtyard"};  ///< environments (bundled names or files)
+    std::vector<int> lights{0, 1, 4, 16, 64, 256};         ///< extracted-light counts compared
+    int reference = 1024;                                  ///< the count every other is compared against
+    int width = 320;                                       ///< image width in pixels (height from the camera aspect)
+    int repeat = 3;                                        ///< timed runs per N (fewer once an N has taken 2 s); the median is reported
+    int threads = 0;                                       ///< 0 = all cores
+    std::string timing = "cpu";                            ///< "cpu": process CPU time, "wall": the render's wall time
+    std::string aa = "center";                             ///< anti-aliasing mode: one centre ray keeps the error the lighting's
+    float min_weight = 0.f;                                ///< 0: every light traced, the error is the split's alone;
+                                                           ///< `render`'s 1/255 drops the lights too dim at a point
+    std::vector<std::string> overhead_scenes;              ///< scenes of the lookup-cost measurement; empty = the bundled ones
+    int overhead_repeat = 7;                               ///< timed runs per scene and variant (interleaved); the median is reported
+    bool overhead = true;                                  ///< measure the lookup cost at all
+    std::string out = "bench-env";                         ///< output directory (CSV, images, plot)
+    bool plot = true;                                      ///< run scripts/plot_env.py afterwards when possible
+    std::string python = "python3";                        ///< interpreter with matplotlib for the plot
+};
+
+/// Assets of the default run, under assets/gltf/<name>/glTF-Binary/<name>.glb, and the default scene.
+const char* const kDefaultAssets[] = {"Duck", "MetalRoughSpheresNoTextures", "GlassHurricaneCandleHolder",
+                                      "SpecularTest"};
+
+std::vector<std::string> default_assets() {
+    const fs::path assets = fs::path(WHITTED_SOURCE_DIR) / "assets";
+    std::vector<std::string> out;
+    for (const char* name : kDefaultAssets)
+        out.push_back((assets / "gltf" / name / "glTF-Binary" / (std::string(name) + ".glb")).string());
+    out.push_back((assets / "scenes" / "default.glb").string());
+    return out;
+}
+
+/// The bundled scenes: assets/scenes/*.json in name order, then default.glb.
+std::vector<std::string> bundled_scenes() {
+    const fs::path dir = fs::path(WHITTED_SOURCE_DIR) / "assets" / "scenes";
+    std::vector<std::string> out;
+    for (const auto& e : fs::directory_iterator(dir))
+        if (e.is_regular_file() && e.path().extension() == ".json") out.push_back(e.path().string());
+    std::sort(out.begin(), out.end());
+    out.push_back((dir / "default.glb").string());
+    return out;
+}
+
+std::string label_of(const std::string& path) { return fs::path(path).stem().string(); }
+
+/// The bench's render settings for `scene`: its file's settings, then the bench's size, threads,
+/// anti-aliasing and min weight (what the file sets of the latter wins, as in `render`).
+RenderSettings bench_settings(const Scene& scene, const BenchEnvOptions& o) {
+    RenderSettings rs;
+    rs.integrator.min_weight = o.min_weight;
+    apply_scene_settings(scene.settings, rs);
+    rs.width = o.width;
+    rs.height = 0;
+    rs.threads = o.threads;
+    rs.progress = false;
+    rs.aa = AaSettings{};
+    rs.aa.mode = parse_aa_mode(o.aa);
+    return rs;
+}
+
+/// One scene to time: its renderer and the runs so far.
+struct Timed {
+    std::unique_ptr<Scene> scene;
+    std::unique_ptr<Renderer> renderer;
+    std::vector<double> cpu, wall;  ///< seconds of each run
+    double spent = 0.0;             ///< seconds spent rendering it (the 2 s budget)
+    RenderStats stats;              ///< of the last run (every run traces the same rays)
+    Film film;                      ///< of the last run (every run gives the same image)
+
+    Timed(Scene s, const BenchEnvOptions& o)
+        : scene(std::make_unique<Scene>(std::move(s))),
+          renderer(std::make_unique<Renderer>(*scene, bench_settings(*scene, o))) {}
+
+    /// Renders once and records its times.
+    void run(bool cpu_timing) {
+        const double cpu0 = process_cpu_seconds();
+        film = renderer->render(&stats);
+        cpu.push_back(process_cpu_seconds() - cpu0);
+        wall.push_back(stats.render_seconds);
+        spent += cpu_timing ? cpu.back() : wall.back();
+    }
+    /// The reported time: the median run by the chosen clock.
+    double seconds(bool cpu_timing) const { return median(cpu_timing ? cpu : wall); }
+};
+
+/// Renders every scene of `batch` `repeat` times, one round over the batch at a time, so that a
+/// burst of load on a shared machine spreads over the batch; with `budget` > 0 a scene that has
+/// taken that many seconds is not run again.
+void time_interleaved(std::vector<Timed*> batch, int repeat, double budget, bool cpu_timing) {
+    for (int round = 0; round < std::max(1, repeat); ++round)
+        for (Timed* t : batch)
+            if (round == 0 || budget <= 0.0 || t->spent < budget) t->run(cpu_timing);
+}
+
+/// What one N measured on one asset and map.
+struct Row {
+    std::string asset, map;
+    int lights = 0;             ///< N asked for
+    size_t extracted = 0;       ///< lights the split gave (fewer when the map has less to extract)
+    double rmse_display = 0.0;  ///< against the reference N, display values 0..1
+    double rmse_linear = 0.0;
+    double max_display = 0.0;   ///< largest channel difference, display values
+    double seconds = 0.0, cpu_seconds = 0.0, wall_seconds = 0.0;
+    size_t runs = 0;
+    RenderStats stats;
+};
+
+size_t environment_light_count(const Scene& scene) {
+    return size_t(std::count_if(scene.lights.begin(), scene.lights.end(), [](const Light& l) { return l.from_environment; }));
+}
+
+/// Sum of the rows' times at `n`, and whether every row at `n` is within one code.
+struct Candidate {
+    int lights = 0;
+    double seconds = 0.0;
+    bool within = true;
+    const Row* worst = nullptr;  ///< the row of largest RMSE at this N
+};
+
+std::vector<Candidate> candidates(const std::vector<int>& counts, const std::vector<Row>& rows) {
+    std::vector<Candidate> out;
+    for (const int n : counts) {
+        Candidate c;
+        c.lights = n;
+        for (const Row& r : rows) {
+            if (r.lights != n) continue;
+            c.seconds += r.seconds;
+            c.within = c.within && r.rmse_display <= kOneCode;
+            if (!c.worst || r.rmse_display > c.worst->rmse_display) c.worst = &r;
+        }
+        out.push_back(c);
+    }
+    return out;
+}
+
+/// Measures and prints the extracted-light sweep; returns its rows.
+std::vector<Row> light_sweep(const BenchEnvOptions& o, const std::vector<int>& counts, const fs::path& out) {
+    const bool cpu_timing = o.timing == "cpu";
+    const DisplayTransform display(ColorSettings{});
+    std::ofstream csv(out / "env.csv");
+    csv << "asset,map,lights,extracted_lights,reference,rmse_display,rmse_display_codes,rmse_linear,max_display,"
+           "within_one_code,seconds,timing,runs,cpu_seconds,wall_seconds,shadow_rays,shadow_skipped_dim,total_rays,"
+           "width,height,threads,load\n";
+    std::vector<Row> rows;
+    for (const std::string& asset : o.assets.empty() ? default_assets() : o.assets) {
+        for (const std::string& map : o.maps) {
+            std::vector<Timed> timed;
+            timed.reserve(counts.size());
+            for (const int n : counts) {
+                ImportOptions io;
+                io.environment = map;
+                io.environment_lights = n;
+                timed.emplace_back(load_scene(asset, io), o);
+            }
+            const ImageSize size = timed.front().renderer->image_size();
+            std::printf("== %s / %s: %dx%d, %zu triangles, %s, %s time, load %.2f\n", label_of(asset).c_str(),
+                        map.c_str(), size.width, size.height, timed.front().scene->instanced_triangle_count(),
+                        o.aa.c_str(), cpu_timing ? "process CPU" : "wall", load_average_1min());
+            std::vector<Timed*> batch;
+            for (Timed& t : timed) batch.push_back(&t);
+            time_interleaved(batch, o.repeat, 2.0, cpu_timing);
+
+            const size_t ref_index = size_t(std::find(counts.begin(), counts.end(), o.reference) - counts.begin());
+            const std::vector<float> ref_linear = packed_rgb(timed[ref_index].film);
+            const std::vector<float> ref_display = display_rgb(ref_linear, display);
+            const double ref_seconds = timed[ref_index].seconds(cpu_timing);
+            std::printf("   %6s %6s %10s %6s %10s %9s %9s %4s %12s %7s\n", "N", "lights", "rmse disp", "codes", "rmse lin",
+                        "max disp", "time[s]", "runs", "shadow rays", "vs ref");
+            for (size_t k = 0; k < counts.size(); ++k) {
+                Timed& t = timed[k];
+                Row r;
+                r.asset = label_of(asset);
+                r.map = map;
+                r.lights = counts[k];
+                r.extracted = environment_light_count(*t.scene);
+                const std::vector<float> linear = packed_rgb(t.film);
+                const std::vector<float> disp = display_rgb(linear, display);
+                r.rmse_display = rmse(disp, ref_display);
+                r.rmse_linear = rmse(linear, ref_linear);
+                r.max_display = max_abs_difference(disp, ref_display);
+                r.seconds = t.seconds(cpu_timing);
+                r.cpu_seconds = median(t.cpu);
+                r.wall_seconds = median(t.wall);
+                r.runs = t.cpu.size();
+                r.stats = t.stats;
+                write_image(t.film, (out / fmt::format("{}-{}-{}.png", r.asset, label_of(map), r.lights)).string(),
+                            OutputSettings{});
+                t.film = Film{};
+                std::printf("   %6d %6zu %10.5f %6.2f %10.5f %9.4f %9.4f %4zu %12llu %6.3fx%s\n", r.lights, r.extracted,
+                            r.rmse_display, r.rmse_display / kOneCode, r.rmse_linear, r.max_display, r.seconds, r.runs,
+                            (unsigned long long)r.stats.rays.shadow, r.seconds / ref_seconds,
+                            r.rmse_display <= kOneCode ? "" : "  > 1/255");
+                csv << fmt::format("{},{},{},{},{},{:.6g},{:.4f},{:.6g},{:.6g},{},{:.6f},{},{},{:.6f},{:.6f},{},{},{},{},{},{},{:.2f}\n",
+                                   r.asset, r.map, r.lights, r.extracted, o.reference, r.rmse_display,
+                                   r.rmse_display / kOneCode, r.rmse_linear, r.max_display,
+                                   r.rmse_display <= kOneCode ? 1 : 0, r.seconds, o.timing, r.runs, r.cpu_seconds,
+                                   r.wall_seconds, r.stats.rays.shadow, r.stats.rays.shadow_skipped_dim,
+                                   r.stats.rays.total(), size.width, size.height, r.stats.threads, load_average_1min());
+                csv.flush();
+                rows.push_back(std::move(r));
+            }
+        }
+    }
+    return rows;
+}
+
+/// Prints the default the sweep chooses: the N of least total time within one code everywhere.
+void print_choice(const BenchEnvOptions& o, const std::vector<int>& counts, const std::vector<Row>& rows) {
+    const std::vector<Candidate> cs = candidates(counts, rows);
+    const Candidate* chosen = nullptr;
+    for (const Candidate& c : cs)
+        if (c.within && (!chosen || c.seconds < chosen->seconds)) chosen = &c;
+    const Candidate& ref = *std::find_if(cs.begin(), cs.end(), [&](const Candidate& c) { return c.lights == o.reference; });
+    std::printf("== choice: total time over every asset and map, worst display RMSE against N = %d\n", o.reference);
+    for (const Candidate& c : cs)
+        std::printf("   N = %-5d %9.4f s (%6.3fx)  worst %.5f (%.2f codes, %s / %s)%s\n", c.lights, c.seconds,
+                    c.seconds / ref.seconds, c.worst->rmse_display, c.worst->rmse_display / kOneCode,
+                    c.worst->asset.c_str(), c.worst->map.c_str(), c.within ? "" : "  > 1/255");
+    std::printf("chosen default --env-lights: %d\n", chosen->lights);
+    // What rules out the cheaper counts: the most expensive of them, and its worst asset and map.
+    const Candidate* next = nullptr;
+    for (const Candidate& c : cs)
+        if (c.seconds < chosen->seconds && (!next || c.seconds > next->seconds)) next = &c;
+    if (next)
+        std::printf("   decided by %s / %s: the next cheaper N = %d is %.2f codes off (RMSE %.5f > 1/255)\n",
+                    next->worst->asset.c_str(), next->worst->map.c_str(), next->lights,
+                    next->worst->rmse_display / kOneCode, next->worst->rmse_display);
+    else
+        std::printf("   no listed N is cheaper\n");
+    std::printf("   closest to the limit at N = %d: %s / %s, %.2f codes (RMSE %.5f)\n", chosen->lights,
+                chosen->worst->asset.c_str(), chosen->worst->map.c_str(), chosen->worst->rmse_display / kOneCode,
+                chosen->worst->rmse_display);
+    const auto current = std::find_if(cs.begin(), cs.end(), [](const Candidate& c) { return c.lights == kDefaultEnvironmentLights; });
+    if (current != cs.end())
+        std::printf("   the current default kDefaultEnvironmentLights = %d: worst %.2f codes (%s / %s), %s\n",
+                    kDefaultEnvironmentLights, current->worst->rmse_display / kOneCode, current->worst->asset.c_str(),
+                    current->worst->map.c_str(), current->within ? "within 1/255" : "NOT within 1/255");
+}
+
+/// The environment's lookup cost: each scene with `map` and no extracted light against no
+/// environment, both with the same lights (a scene without lights gets the default light only
+/// when it has no environment; it is left out of the plain render too).
+void lookup_overhead(const BenchEnvOptions& o, const std::string& map, const fs::path& out) {
+    const bool cpu_timing = o.timing == "cpu";
+    std::ofstream csv(out / "env_overhead.csv");
+    csv << "scene,map,plain_seconds,env_seconds,ratio,target_met,timing,runs,lights,environment_ambient,"
+           "environment_visible,plain_total_rays,env_total_rays,width,height,threads,load\n";
+    std::printf("== lookup cost: %s with 0 extracted lights against a plain background, %s time, median of %d, load %.2f\n",
+                map.c_str(), cpu_timing ? "process CPU" : "wall", o.overhead_repeat, load_average_1min());
+    std::printf("   %-24s %10s %10s %7s %6s  %s\n", "scene", "plain[s]", "env[s]", "ratio", "lights", "environment terms");
+    for (const std::string& path : o.overhead_scenes.empty() ? bundled_scenes() : o.overhead_scenes) {
+        ImportOptions with;
+        with.environment = map;
+        with.environment_lights = 0;
+        Scene env_scene = load_scene(path, with);
+        ImportOptions without;
+        without.no_environment = true;
+        Scene plain_scene = load_scene(path, without);
+        const auto is_default = [](const Light& l) { return l.is_default; };
+        if (std::none_of(env_scene.lights.begin(), env_scene.lights.end(), is_default))
+            std::erase_if(plain_scene.lights, is_default);
+        const size_t lights = env_scene.lights.size();
+        Timed plain(std::move(plain_scene), o), env(std::move(env_scene), o);
+        time_interleaved({&plain, &env}, o.overhead_repeat, 0.0, cpu_timing);
+        const RenderSettings rs = bench_settings(*env.scene, o);
+        const std::string terms = fmt::format("{}{}", rs.integrator.environment_visible ? "background" : "(hidden)",
+                                              rs.integrator.environment_ambient ? " + SH9 ambient" : " (file's ambient)");
+        const double ratio = env.seconds(cpu_timing) / plain.seconds(cpu_timing);
+        std::printf("   %-24s %10.4f %10.4f %6.3fx %6zu  %s%s\n", label_of(path).c_str(), plain.seconds(cpu_timing),
+                    env.seconds(cpu_timing), ratio, lights, terms.c_str(), ratio <= 1.10 ? "" : "  > 1.10");
+        const ImageSize size = env.renderer->image_size();
+        csv << fmt::format("{},{},{:.6f},{:.6f},{:.4f},{},{},{},{},{},{},{},{},{},{},{},{:.2f}\n", label_of(path), map,
+                           plain.seconds(cpu_timing), env.seconds(cpu_timing), ratio, ratio <= 1.10 ? 1 : 0, o.timing,
+                           env.cpu.size(), lights, rs.integrator.environment_ambient ? 1 : 0,
+                           rs.integrator.environment_visible ? 1 : 0, plain.stats.rays.total(), env.stats.rays.total(),
+                           size.width, size.height, env.stats.threads, load_average_1min());
+        csv.flush();
+    }
+}
+
+int run_bench_env(const BenchEnvOptions& o) {
+    if (o.maps.empty()) throw Error("bench env: --maps: give at least one environment");
+    if (o.lights.empty()) throw Error("bench env: --lights: give at least one count");
+    for (const int n : o.lights)
+        if (n < 0) throw Error(fmt::format("bench env: --lights: counts are 0 or more (got {})", n));
+    (void)parse_aa_mode(o.aa);
+    const fs::path out(o.out);
+    fs::create_directories(out);
+    // Every count once, the reference among them, in increasing order.
+    std::vector<int> counts = o.lights;
+    counts.push_back(o.reference);
+    std::sort(counts.begin(), counts.end());
+    counts.erase(std::unique(counts.begin(), counts.end()), counts.end());
+
+    const std::vector<Row> rows = light_sweep(o, counts, out);
+    print_choice(o, counts, rows);
+    if (o.overhead) lookup_overhead(o, o.maps.front(), out);
+    const std::string overhead_csv = o.overhead ? ", " + (out / "env_overhead.csv").string() : "";
+    std::printf("wrote %s%s\n", (out / "env.csv").c_str(), overhead_csv.c_str());
+    if (o.plot) run_plot_script(o.python, "plot_env.py", out / "env.csv", out, "bench env");
+    return 0;
+}
+
+}  // namespace
+
+Command register_bench_env(CLI::App& bench) {
+    auto o = std::make_shared<BenchEnvOptions>();
+    CLI::App* app = bench.add_subcommand(
+        "env", "Environment lights: display error of N extracted lights against the reference N, and their time "
+               "(docs/environment.md)");
+    app->add_option("assets", o->assets, "glTF files (default: Duck, MetalRoughSpheresNoTextures, "
+                    "GlassHurricaneCandleHolder, SpecularTest and assets/scenes/default.glb)");
+    app->add_option("--maps", o->maps, "Environments, comma-separated (bundled names or files)")->delimiter(',')
+        ->capture_default_str();
+    app->add_option("--lights", o->lights, "Extracted-light counts to compare, comma-separated")->delimiter(',')
+        ->capture_default_str();
+    app->add_option("--reference", o->reference, "The count every other is compared against")
+        ->check(CLI::Range(0, 65536))->capture_default_str();
+    app->add_option("--width", o->width, "Image width (height from the camera aspect)")->check(CLI::Range(8, 4096))
+        ->capture_default_str();
+    app->add_option("--repeat", o->repeat, "Timed runs per count (the median is reported; fewer once a count has "
+                    "taken 2 s)")->check(CLI::Range(1, 100))->capture_default_str();
+    app->add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 1024))->capture_default_str();
+    app->add_option("--timing", o->timing, "Time each render by process CPU time (cpu: robust on a shared machine, "
+                    "exact with --threads 1) or wall-clock time (wall)")->check(CLI::IsMember({"cpu", "wall"}))
+        ->capture_default_str();
+    app->add_option("--aa", o->aa, "Anti-aliasing mode of every render")
+        ->check(CLI::IsMember({"center", "corners", "adaptive", "stratified"}))->capture_default_str();
+    app->add_option("--min-weight", o->min_weight, "Lights and secondary rays below this weight are not traced "
+                    "(as `whitted render --min-weight`; 0 = all, so the error is the split's alone)")->check(CLI::Range(0.0, 1.0))->capture_default_str();
+    app->add_option("--overhead-scenes", o->overhead_scenes, "Scenes of the lookup-cost measurement (default: "
+                    "assets/scenes/*.json and default.glb)");
+    app->add_option("--overhead-repeat", o->overhead_repeat, "Timed runs per scene and variant of the lookup-cost "
+                    "measurement (the median is reported)")->check(CLI::Range(1, 100))->capture_default_str();
+    app->add_flag("!--no-overhead", o->overhead, "Skip the lookup-cost measurement");
+    app->add_option("--out", o->out, "Output directory: env.csv, env_overhead.csv, PNGs, plot")->capture_default_str();
+    app->add_flag("!--no-plot", o->plot, "Do not run scripts/plot_env.py");
+    app->add_option("--python", o->python, "Python interpreter with matplotlib for the plot")->capture_default_str();
+    return Command{app, [o] { return run_bench_env(*o); }};
+}
+
+}  // namespace whitted::app

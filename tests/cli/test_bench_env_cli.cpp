@@ -1,0 +1,82 @@
+// `whitted bench env` end to end through the executable, on one small asset, one map and two
+// light counts at a tiny size: the CSVs' columns, the reference row's zero error, finite errors,
+// and a printed default that is one of the counts compared. No time is checked.
+#include <gtest/gtest.h>
+
+#include "tests/support/cli_util.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using whitted::test::num;
+using whitted::test::read_csv;
+using whitted::test::Result;
+using whitted::test::run;
+
+using Row = std::map<std::string, std::string>;
+
+const std::string kBox = std::string(WHITTED_ASSETS_DIR) + "/gltf/Box/glTF-Binary/Box.glb";
+const std::string kScene = std::string(WHITTED_ASSETS_DIR) + "/scenes/whitted1980.json";
+
+TEST(BenchEnvCli, CsvColumnsReferenceRowAndAListedDefault) {
+    const fs::path out = whitted::test::scratch_dir("whitted_bench_env_cli", "sweep");
+    const Result r = run("bench env '" + kBox + "' --maps studio --lights 0,16 --reference 16 --width 24 --repeat 1 "
+                         "--threads 1 --overhead-scenes '" + kScene + "' --overhead-repeat 1 --no-plot --out '" +
+                         out.string() + "'");
+    ASSERT_EQ(r.code, 0) << r.out << r.err;
+
+    std::vector<std::string> header;
+    const std::vector<Row> rows = read_csv(out / "env.csv", &header);
+    for (const char* column : {"asset", "map", "lights", "extracted_lights", "reference", "rmse_display",
+                               "rmse_display_codes", "rmse_linear", "seconds", "timing", "runs", "shadow_rays"})
+        EXPECT_NE(std::find(header.begin(), header.end(), column), header.end()) << column;
+    ASSERT_EQ(rows.size(), 2u);
+    EXPECT_EQ(rows[0].at("lights"), "0");
+    EXPECT_EQ(rows[1].at("lights"), "16");
+    for (const Row& row : rows) {
+        EXPECT_EQ(row.count("_bad"), 0u) << row.at("_bad");
+        EXPECT_EQ(row.at("asset"), "Box");
+        EXPECT_EQ(row.at("map"), "studio");
+        EXPECT_TRUE(std::isfinite(num(row, "rmse_display"))) << row.at("rmse_display");
+        EXPECT_TRUE(std::isfinite(num(row, "rmse_linear"))) << row.at("rmse_linear");
+        EXPECT_GE(num(row, "rmse_display"), 0.0);
+        EXPECT_LE(num(row, "rmse_display"), 1.0);
+    }
+    EXPECT_EQ(num(rows[1], "rmse_display"), 0.0);  // the reference against itself
+    EXPECT_EQ(num(rows[0], "shadow_rays"), 0.0);   // no extracted light, no shadow ray
+    EXPECT_GT(num(rows[1], "extracted_lights"), 0.0);
+
+    const std::string key = "chosen default --env-lights: ";
+    const size_t at = r.out.find(key);
+    ASSERT_NE(at, std::string::npos) << r.out;
+    const int chosen = std::stoi(r.out.substr(at + key.size()));
+    EXPECT_TRUE(chosen == 0 || chosen == 16) << chosen;
+    // The choice follows the CSV: 0 only when it is within one code of the reference.
+    if (chosen == 0) {
+        EXPECT_LE(num(rows[0], "rmse_display"), 1.0 / 255.0);
+    }
+
+    const std::vector<Row> overhead = read_csv(out / "env_overhead.csv", &header);
+    for (const char* column : {"scene", "map", "plain_seconds", "env_seconds", "ratio", "lights"})
+        EXPECT_NE(std::find(header.begin(), header.end(), column), header.end()) << column;
+    ASSERT_EQ(overhead.size(), 1u);
+    EXPECT_EQ(overhead[0].at("scene"), "whitted1980");
+    EXPECT_TRUE(std::isfinite(num(overhead[0], "ratio")));
+    EXPECT_EQ(overhead[0].at("plain_total_rays"), overhead[0].at("env_total_rays"));  // lookups only, no extra ray
+}
+
+TEST(BenchEnvCli, NegativeCountIsOneErrorLine) {
+    const fs::path out = whitted::test::scratch_dir("whitted_bench_env_cli", "bad");
+    const Result r = run("bench env '" + kBox + "' --lights 0,-1 --width 16 --no-plot --no-overhead --out '" + out.string() + "'");
+    EXPECT_NE(r.code, 0);
+    EXPECT_NE(r.err.find("--lights"), std::string::npos) << r.err;
+}
+
+}  // namespace
