@@ -116,8 +116,10 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
             ++counters.shadow_skipped_zero;
             return;
         }
-        // One of many lights cut from the environment, too dim here to change the pixel.
-        if (light.from_environment && s.weight * max_component(ls.intensity * term) < m_settings.min_weight) {
+        // One of the many lights cut from the environment, too dim here to matter: all of them
+        // together that are skipped at this point stay below min_weight.
+        if (light.from_environment &&
+            s.weight * max_component(ls.intensity * term) * m_environment_lights < m_settings.min_weight) {
             ++counters.shadow_skipped_dim;
             return;
         }
@@ -357,6 +359,7 @@ WhittedIntegrator::WhittedIntegrator(const SceneView& view, const Accelerator& a
     pick(std::make_index_sequence<std::size(kKernels)>{});
     RT_CHECK(m_trace != nullptr);
     m_environment = view.environment();
+    for (const Light& l : view.scene().lights) m_environment_lights += l.from_environment ? 1.f : 0.f;
     const std::optional<Environment>& env = view.scene().environment;
     if (env && env->ambient_sh && settings.environment_ambient) m_ambient_sh = &*env->ambient_sh;
     if (m_kernel.transmission) {

@@ -4,6 +4,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -102,6 +104,28 @@ TEST(EnvironmentRender, ConstantAmbientWhenGiven) {
     constant.environment_ambient = false;
     expect_near_rel(render(scene).beauty[16 * 32 + 16], Color(2.f), 0.01f);
     EXPECT_EQ(render(scene, constant).beauty[16 * 32 + 16], Color(0.25f));
+}
+
+// Extracted lights too dim to matter cast no shadow ray, and all of those skipped at a point stay
+// below min_weight: many lights at the CLI's 1/255 give the image of min_weight 0 within 1/255.
+TEST(EnvironmentRender, DimLightsSkippedWithinMinWeight) {
+    WhittedCoeffs white;
+    white.kd = white.ka = Color(0.8f);
+    Environment env;
+    auto image = std::make_shared<EnvironmentImage>();
+    image->width = 64;
+    image->height = 32;
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 64; ++x) image->texels.push_back(Color(0.05f + 0.9f * float((x * 7 + y * 13) % 17) / 16.f));
+    env.image = image;
+    const Scene scene = sphere_under(white, env, 256);
+    IntegratorSettings exact, cut;
+    cut.min_weight = 1.f / 255.f;
+    const Film a = render(scene, exact), b = render(scene, cut);
+    float worst = 0.f;
+    for (size_t i = 0; i < a.beauty.size(); ++i)
+        for (int k = 0; k < 3; ++k) worst = std::max(worst, std::fabs(a.beauty[i][k] - b.beauty[i][k]));
+    EXPECT_LE(worst, 1.f / 255.f);
 }
 
 /// A scene file with a plane, a sphere and a light, and optionally an environment entry.
