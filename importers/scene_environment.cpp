@@ -41,7 +41,9 @@ void setup_environment(Scene& scene, const ImportOptions& options) {
     if (options.environment_exposure) env.exposure_stops = *options.environment_exposure;
 
     // Its light: the brightest regions as directional lights, the rest as the SH ambient. The
-    // lights replace the default light a scene without lights was given.
+    // lights replace the default light a scene without lights was given. The split reads the
+    // full map, so no residual is built for it.
+    env.extraction_threshold = kInfinity;
     const EnvironmentMap map(env);
     const EnvironmentLighting lighting = map.split(std::max(options.environment_lights, 0));
     std::erase_if(scene.lights, [](const Light& l) { return l.is_default; });
@@ -51,6 +53,7 @@ void setup_environment(Scene& scene, const ImportOptions& options) {
         scene.lights.push_back(light);
     }
     env.ambient_sh = lighting.residual_sh;
+    env.extraction_threshold = lighting.threshold;  // reflected rays see what the lights leave
 }
 
 }  // namespace whitted

@@ -229,9 +229,9 @@ std::string describe_scene(const Scene& scene) {
         const WhittedCoeffs c = map_material_constant(m, mapping);
         line(
             fmt::format("material[{}] whitted: kd={} ka={} ks={} n={} kr={} kt={} ior={} thin={} emission={} "
-                        "absorption={}",
+                        "absorption={} kg={} roughness={}",
                         i, vec3(c.kd), vec3(c.ka), vec3(c.ks), num(c.n), vec3(c.kr), vec3(c.kt), num(c.ior),
-                        yes_no(c.thin), vec3(c.emission), vec3(c.absorption)));
+                        yes_no(c.thin), vec3(c.emission), vec3(c.absorption), vec3(c.kg), num(c.roughness)));
         const std::string tex = texture_slot("base_color", m.base_color_texture, false) +
                                 texture_slot("metallic_roughness", m.metallic_roughness_texture, false) +
                                 texture_slot("normal", m.normal_texture, true) +

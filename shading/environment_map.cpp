@@ -1,5 +1,5 @@
-// Environment map: MIP lat-long lookups, the median-cut split into lights plus SH9 ambient, and
-// the GGX prefilter for rough reflections (docs/environment.md).
+// Environment map: MIP lat-long lookups, the median-cut split into lights plus SH9 ambient, the
+// residual the lights leave, and the GGX prefilter of both for rough reflections (docs/environment.md).
 
 #include "shading/environment_map.h"
 
@@ -114,6 +114,32 @@ EnvironmentMap::Level downsample(const EnvironmentMap::Level& src) {
         }
     set_poles(dst);
     return dst;
+}
+
+/// MIP pyramid from `base` down to 1 x 1.
+std::vector<EnvironmentMap::Level> pyramid(EnvironmentMap::Level base) {
+    std::vector<EnvironmentMap::Level> levels;
+    levels.push_back(std::move(base));
+    while (levels.back().width > 1 || levels.back().height > 1) levels.push_back(downsample(levels.back()));
+    return levels;
+}
+
+/// Trilinear lookup of a pyramid at a map-local direction: bilinear within a level, linear between
+/// the two levels around `lod` (level 0 below 0, the last level beyond it).
+Color sample_pyramid(const std::vector<EnvironmentMap::Level>& levels, const Vec3f& map_dir, float lod) {
+    const Vec2f uv = latlong_uv(map_dir);
+    const int last = int(levels.size()) - 1;
+    if (!(lod > 0.f)) return levels.front().bilinear(uv.x, uv.y);
+    if (lod >= float(last)) return levels.back().bilinear(uv.x, uv.y);
+    const int l0 = int(lod);
+    const float f = lod - float(l0);
+    return lerp(levels[size_t(l0)].bilinear(uv.x, uv.y), levels[size_t(l0) + 1].bilinear(uv.x, uv.y), f);
+}
+
+/// What the extracted lights leave of texel c of luminance lum: scaled down to luminance
+/// `threshold` when above it (the hue kept), else c.
+Color residual_texel(const Color& c, double lum, double threshold) {
+    return lum > threshold ? c * float(threshold / lum) : c;
 }
 
 /// Radical inverse in base 2 (van der Corput), the second Hammersley coordinate.
@@ -235,6 +261,60 @@ void tangent_frame(const Vec3f& n, Vec3f& t, Vec3f& b) {
     b = {c, sign + n.y * n.y * a, -n.y};
 }
 
+/// The GGX prefilter of a pyramid, one lat-long per kPrefilterRoughness, by filtered importance
+/// sampling (Krivanek & Colbert 2008): a fixed Hammersley set per texel, each sample read from the
+/// MIP level whose texel matches its solid angle.
+std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::Level>& source, WorkerPool& pool) {
+    const double texel_sr = 4.0 * kPiD / (double(source.front().width) * double(source.front().height));
+    std::vector<EnvironmentMap::Level> out;
+    struct Row {
+        size_t level;
+        int y;
+    };
+    std::vector<Row> rows;
+    for (size_t k = 0; k < kPrefilterRoughness.size(); ++k) {
+        EnvironmentMap::Level level;
+        level.width = kPrefilterWidth[k];
+        level.height = kPrefilterWidth[k] / 2;
+        level.texels.resize(size_t(level.width) * size_t(level.height));
+        for (int y = 0; y < level.height; ++y) rows.push_back({k, y});
+        out.push_back(std::move(level));
+    }
+    pool.for_each(rows.size(), [&](size_t item, int) {
+        EnvironmentMap::Level& level = out[rows[item].level];
+        const float alpha = kPrefilterRoughness[rows[item].level] * kPrefilterRoughness[rows[item].level];
+        const float a2 = alpha * alpha;
+        const int y = rows[item].y;
+        for (int x = 0; x < level.width; ++x) {
+            const Vec3f n = latlong_direction((float(x) + 0.5f) / float(level.width), (float(y) + 0.5f) / float(level.height));
+            Vec3f t, b;
+            tangent_frame(n, t, b);
+            Color sum(0.f);
+            float weight = 0.f;
+            for (int s = 0; s < kPrefilterSamples; ++s) {
+                // GGX half vector (normal = view = n), its reflection l, pdf(l) = D(h) / 4.
+                const float xi1 = (float(s) + 0.5f) / float(kPrefilterSamples), xi2 = radical_inverse2(uint32_t(s));
+                const float cos2 = (1.f - xi1) / (1.f + (a2 - 1.f) * xi1);
+                const float cos_h = std::sqrt(cos2), sin_h = std::sqrt(std::max(0.f, 1.f - cos2));
+                const float phi = 2.f * kPi * xi2;
+                const Vec3f h = t * (sin_h * std::cos(phi)) + b * (sin_h * std::sin(phi)) + n * cos_h;
+                const Vec3f l = h * (2.f * cos_h) - n;
+                const float n_dot_l = dot(n, l);
+                if (n_dot_l <= 0.f) continue;
+                const float denom = cos2 * (a2 - 1.f) + 1.f;
+                const float pdf = a2 / (kPi * denom * denom) * 0.25f;
+                const float sample_sr = 1.f / (float(kPrefilterSamples) * pdf);
+                const float lod = std::max(0.f, 0.5f * std::log2(sample_sr / float(texel_sr)) + 1.f);
+                sum += sample_pyramid(source, l, lod) * n_dot_l;
+                weight += n_dot_l;
+            }
+            level.texels[size_t(y) * size_t(level.width) + size_t(x)] = weight > 0.f ? sum / weight : Color(0.f);
+        }
+    });
+    for (EnvironmentMap::Level& level : out) set_poles(level);
+    return out;
+}
+
 }  // namespace
 
 // ---- lat-long parameterisation ----------------------------------------------------------------
@@ -351,58 +431,23 @@ EnvironmentMap::EnvironmentMap(const Environment& env, int threads) {
     m_mean = Color(sum / (4.0 * kPiD));
 
     // MIP pyramid down to 1 x 1.
-    m_levels.push_back(std::move(base));
-    while (m_levels.back().width > 1 || m_levels.back().height > 1) m_levels.push_back(downsample(m_levels.back()));
+    m_levels = pyramid(std::move(base));
 
-    // GGX prefilter by filtered importance sampling (Krivanek & Colbert 2008): a fixed Hammersley
-    // set per texel, each sample read from the MIP level whose texel matches its solid angle.
-    const double texel_sr = 4.0 * kPiD / (double(width()) * double(height()));
-    struct Row {
-        size_t level;
-        int y;
-    };
-    std::vector<Row> rows;
-    for (size_t k = 0; k < kPrefilterRoughness.size(); ++k) {
-        Level level;
-        level.width = kPrefilterWidth[k];
-        level.height = kPrefilterWidth[k] / 2;
-        level.texels.resize(size_t(level.width) * size_t(level.height));
-        for (int y = 0; y < level.height; ++y) rows.push_back({k, y});
-        m_prefiltered.push_back(std::move(level));
+    // The residual the extracted lights leave, with its own pyramid only where some texel was extracted.
+    m_threshold = env.extraction_threshold;
+    const double threshold = m_threshold;
+    const std::vector<Color>& texels = m_levels.front().texels;
+    if (std::any_of(texels.begin(), texels.end(), [&](const Color& c) { return luminance(c) > threshold; })) {
+        Level residual = m_levels.front();
+        for (Color& c : residual.texels) c = residual_texel(c, luminance(c), threshold);
+        set_poles(residual);
+        m_residual = pyramid(std::move(residual));
     }
+
+    // The GGX prefilter of the map and of the residual.
     WorkerPool pool(threads);
-    pool.for_each(rows.size(), [&](size_t item, int) {
-        Level& level = m_prefiltered[rows[item].level];
-        const float alpha = kPrefilterRoughness[rows[item].level] * kPrefilterRoughness[rows[item].level];
-        const float a2 = alpha * alpha;
-        const int y = rows[item].y;
-        for (int x = 0; x < level.width; ++x) {
-            const Vec3f n = latlong_direction((float(x) + 0.5f) / float(level.width), (float(y) + 0.5f) / float(level.height));
-            Vec3f t, b;
-            tangent_frame(n, t, b);
-            Color sum(0.f);
-            float weight = 0.f;
-            for (int s = 0; s < kPrefilterSamples; ++s) {
-                // GGX half vector (normal = view = n), its reflection l, pdf(l) = D(h) / 4.
-                const float xi1 = (float(s) + 0.5f) / float(kPrefilterSamples), xi2 = radical_inverse2(uint32_t(s));
-                const float cos2 = (1.f - xi1) / (1.f + (a2 - 1.f) * xi1);
-                const float cos_h = std::sqrt(cos2), sin_h = std::sqrt(std::max(0.f, 1.f - cos2));
-                const float phi = 2.f * kPi * xi2;
-                const Vec3f h = t * (sin_h * std::cos(phi)) + b * (sin_h * std::sin(phi)) + n * cos_h;
-                const Vec3f l = h * (2.f * cos_h) - n;
-                const float n_dot_l = dot(n, l);
-                if (n_dot_l <= 0.f) continue;
-                const float denom = cos2 * (a2 - 1.f) + 1.f;
-                const float pdf = a2 / (kPi * denom * denom) * 0.25f;
-                const float sample_sr = 1.f / (float(kPrefilterSamples) * pdf);
-                const float lod = std::max(0.f, 0.5f * std::log2(sample_sr / float(texel_sr)) + 1.f);
-                sum += sample_lod(l, lod) * n_dot_l;
-                weight += n_dot_l;
-            }
-            level.texels[size_t(y) * size_t(level.width) + size_t(x)] = weight > 0.f ? sum / weight : Color(0.f);
-        }
-    });
-    for (Level& level : m_prefiltered) set_poles(level);
+    m_prefiltered = prefilter(m_levels, pool);
+    if (!m_residual.empty()) m_residual_prefiltered = prefilter(m_residual, pool);
 }
 
 Vec3f EnvironmentMap::world_from_map(const Vec3f& d) const {
@@ -413,33 +458,40 @@ Vec3f EnvironmentMap::map_from_world(const Vec3f& d) const {
     return {m_cos * d.x - m_sin * d.z, d.y, m_sin * d.x + m_cos * d.z};
 }
 
-Color EnvironmentMap::sample_lod(const Vec3f& map_dir, float lod) const {
-    const Vec2f uv = latlong_uv(map_dir);
-    const int last = level_count() - 1;
-    if (!(lod > 0.f)) return m_levels.front().bilinear(uv.x, uv.y);
-    if (lod >= float(last)) return m_levels.back().bilinear(uv.x, uv.y);
-    const int l0 = int(lod);
-    const float f = lod - float(l0);
-    return lerp(m_levels[size_t(l0)].bilinear(uv.x, uv.y), m_levels[size_t(l0) + 1].bilinear(uv.x, uv.y), f);
-}
-
 Color EnvironmentMap::radiance(const Vec3f& dir, float cone_angle) const {
     if (!is_finite(dir)) return Color(0.f);
     const float lod = cone_angle > 0.f ? std::log2(cone_angle / m_texel_angle) : 0.f;
-    return sample_lod(map_from_world(dir), lod);
+    return sample_pyramid(m_levels, map_from_world(dir), lod);
+}
+
+Color EnvironmentMap::residual_radiance(const Vec3f& dir, float cone_angle) const {
+    if (!is_finite(dir)) return Color(0.f);
+    const float lod = cone_angle > 0.f ? std::log2(cone_angle / m_texel_angle) : 0.f;
+    return sample_pyramid(residual_levels(), map_from_world(dir), lod);
 }
 
 Color EnvironmentMap::prefiltered(const Vec3f& dir, float roughness) const {
+    return lookup_prefiltered(m_levels, m_prefiltered, dir, roughness);
+}
+
+Color EnvironmentMap::residual_prefiltered(const Vec3f& dir, float roughness) const {
+    return m_residual.empty() ? prefiltered(dir, roughness)
+                              : lookup_prefiltered(m_residual, m_residual_prefiltered, dir, roughness);
+}
+
+Color EnvironmentMap::lookup_prefiltered(const std::vector<Level>& pyramid, const std::vector<Level>& prefiltered,
+                                         const Vec3f& dir, float roughness) const {
     if (!is_finite(dir)) return Color(0.f);
     const Vec3f d = map_from_world(dir);
     const Vec2f uv = latlong_uv(d);
     const float r = std::isfinite(roughness) ? std::clamp(roughness, 0.f, 1.f) : 1.f;
     if (r <= kPrefilterRoughness.front())
-        return lerp(sample_lod(d, 0.f), m_prefiltered.front().bilinear(uv.x, uv.y), r / kPrefilterRoughness.front());
+        return lerp(pyramid.front().bilinear(uv.x, uv.y), prefiltered.front().bilinear(uv.x, uv.y),
+                    r / kPrefilterRoughness.front());
     size_t k = 1;
     while (k + 1 < kPrefilterRoughness.size() && r > kPrefilterRoughness[k]) ++k;
     const float f = (r - kPrefilterRoughness[k - 1]) / (kPrefilterRoughness[k] - kPrefilterRoughness[k - 1]);
-    return lerp(m_prefiltered[k - 1].bilinear(uv.x, uv.y), m_prefiltered[k].bilinear(uv.x, uv.y), std::clamp(f, 0.f, 1.f));
+    return lerp(prefiltered[k - 1].bilinear(uv.x, uv.y), prefiltered[k].bilinear(uv.x, uv.y), std::clamp(f, 0.f, 1.f));
 }
 
 float split_threshold_factor(int n_lights) {
@@ -477,10 +529,9 @@ EnvironmentLighting EnvironmentMap::split(const SplitSettings& settings) const {
             const size_t i = size_t(y) * size_t(w) + size_t(x);
             const Color c = base.texels[i];
             const double lum = luminance(c);
-            Color residual = c;
+            const Color residual = residual_texel(c, lum, threshold);
             const std::array<float, 9> basis = sh9_basis(world_from_map(Vec3f(grid.direction(x, y))));
             if (extract && lum > threshold) {
-                residual = c * float(threshold / lum);
                 extracted[i] = c - residual;
                 for (size_t k = 0; k < 9; ++k) row_extracted[k] += Vec3d(extracted[i]) * double(basis[k]);
             }
@@ -560,7 +611,9 @@ Color EnvironmentMap::brute_force_irradiance(const Vec3f& n) const {
 size_t EnvironmentMap::bytes() const {
     size_t total = sizeof(*this);
     for (const Level& l : m_levels) total += l.texels.size() * sizeof(Color);
+    for (const Level& l : m_residual) total += l.texels.size() * sizeof(Color);
     for (const Level& l : m_prefiltered) total += l.texels.size() * sizeof(Color);
+    for (const Level& l : m_residual_prefiltered) total += l.texels.size() * sizeof(Color);
     return total;
 }
 
@@ -569,13 +622,13 @@ size_t EnvironmentMap::estimated_bytes(int width, int height) {
     const size_t base = w * h;
     // split(): the extracted texels and the summed-area table of their energy.
     size_t total = sizeof(EnvironmentMap) + base * sizeof(Color) + (w + 1) * (h + 1) * sizeof(double);
-    // The pyramid, level 0 included.
+    // The pyramid and the residual's, level 0 included.
     for (;;) {
-        total += w * h * sizeof(Color);
+        total += 2 * w * h * sizeof(Color);
         if (w == 1 && h == 1) break;
         w = std::max<size_t>(1, w / 2), h = std::max<size_t>(1, h / 2);
     }
-    for (int pw : kPrefilterWidth) total += size_t(pw) * size_t(pw / 2) * sizeof(Color);
+    for (int pw : kPrefilterWidth) total += 2 * size_t(pw) * size_t(pw / 2) * sizeof(Color);
     return total;
 }
 

@@ -1,7 +1,7 @@
 // The environment as the renderer uses it: filtered radiance for rays that leave the scene,
-// its light split into directional lights plus a spherical-harmonic ambient, and a GGX
-// prefiltered copy for rough reflections. Built once from an Environment; every query is const
-// and pure, so any number of threads may share one map.
+// its light split into directional lights plus a spherical-harmonic ambient, and GGX prefiltered
+// copies of the map and of the residual the lights leave, for rough reflections. Built once from
+// an Environment; every query is const and pure, so any number of threads may share one map.
 //
 // Axis convention (docs/environment.md): +Y up; a map-local direction d has
 //   u = 0.5 + atan2(d.z, d.x) / (2 pi),  v = acos(d.y) / pi
@@ -83,8 +83,9 @@ Light to_directional_light(const ExtractedLight& light, const std::string& name)
 
 class EnvironmentMap {
 public:
-    /// Applies 2^exposure_stops, builds the MIP pyramid and the prefiltered levels on `threads`
-    /// worker threads (0 = all hardware threads; the result is the same for any count).
+    /// Applies 2^exposure_stops, builds the MIP pyramid and the prefiltered levels, and the same for
+    /// the residual when env.extraction_threshold leaves one, on `threads` worker threads
+    /// (0 = all hardware threads; the result is the same for any count).
     /// Throws whitted::Error when env.image is null or empty.
     explicit EnvironmentMap(const Environment& env, int threads = 0);
 
@@ -93,10 +94,16 @@ public:
     /// lat-long, bilinear within one (wrap in u; rows blend into the pole's mean at v = 0 and 1).
     Color radiance(const Vec3f& dir, float cone_angle = 0.f) const;
 
+    /// radiance() of the residual: each texel scaled by min(1, T / luminance), T the extraction
+    /// threshold (the extracted rest arrives as the lights). The map itself when nothing was extracted.
+    Color residual_radiance(const Vec3f& dir, float cone_angle = 0.f) const;
+
     /// The map convolved with a GGX lobe of roughness `roughness` (alpha = roughness^2) about
     /// `dir`, normal = view = reflection direction (the split-sum prefilter); between the stored
     /// levels (kPrefilterRoughness) linear in roughness, below the first toward radiance(dir).
     Color prefiltered(const Vec3f& dir, float roughness) const;
+    /// prefiltered() of the residual (below the first level toward residual_radiance(dir)).
+    Color residual_prefiltered(const Vec3f& dir, float roughness) const;
 
     /// Splits the map's light into at most settings.lights extracted lights plus the SH ambient
     /// (0 lights: everything is ambient). Texels whose luminance exceeds the threshold T give
@@ -121,6 +128,10 @@ public:
     int height() const { return m_levels.front().height; }
     /// MIP levels, level 0 = full resolution, the last 1 x 1.
     int level_count() const { return int(m_levels.size()); }
+    /// Luminance above which texels belong to the lights (Environment::extraction_threshold).
+    float extraction_threshold() const { return m_threshold; }
+    /// Whether the residual differs from the map (some texel exceeds the threshold) and has its own pyramid.
+    bool has_residual() const { return !m_residual.empty(); }
     /// Whether camera rays that miss see the map (Environment::visible).
     bool visible() const { return m_visible; }
     /// Name of the image (Environment::image->name).
@@ -129,10 +140,11 @@ public:
     Vec3f world_from_map(const Vec3f& d) const;
     Vec3f map_from_world(const Vec3f& d) const;
 
-    /// Bytes this map holds (MIP pyramid and prefiltered levels).
+    /// Bytes this map holds (MIP pyramids and prefiltered levels).
     size_t bytes() const;
-    /// Upper bound on the bytes a map of width x height holds at its peak: the pyramid, the
-    /// prefiltered levels and split()'s temporaries (extracted texels, summed-area table).
+    /// Upper bound on the bytes a map of width x height holds at its peak: the pyramids and
+    /// prefiltered levels of the map and of its residual, and split()'s temporaries (extracted
+    /// texels, summed-area table).
     static size_t estimated_bytes(int width, int height);
 
     /// One lat-long level: linear RGB texels, row 0 at +Y, and the mean of each pole row.
@@ -145,11 +157,18 @@ public:
     };
 
 private:
-    Color sample_lod(const Vec3f& map_dir, float lod) const;
+    /// The residual's pyramid: m_residual, or the map's when nothing was extracted.
+    const std::vector<Level>& residual_levels() const { return m_residual.empty() ? m_levels : m_residual; }
+    /// prefiltered() over one pyramid and its prefiltered levels.
+    Color lookup_prefiltered(const std::vector<Level>& pyramid, const std::vector<Level>& prefiltered,
+                             const Vec3f& dir, float roughness) const;
 
     std::vector<Level> m_levels;      ///< MIP pyramid of the lat-long (map-local)
+    std::vector<Level> m_residual;    ///< MIP pyramid of the residual; empty when it equals m_levels
     std::vector<Level> m_prefiltered; ///< one per kPrefilterRoughness (map-local)
+    std::vector<Level> m_residual_prefiltered;  ///< of the residual; empty when it equals the map
     Color m_mean{0.f};
+    float m_threshold = kInfinity;    ///< Environment::extraction_threshold
     float m_texel_angle = 0.f;        ///< angular size of a level-0 texel, radians
     float m_cos = 1.f, m_sin = 0.f;   ///< of the rotation about +Y
     bool m_visible = true;

@@ -14,6 +14,11 @@ namespace whitted {
 /// and e^-17 < 2^-24 of ks, so its pow is not evaluated.
 constexpr float kHighlightCutoff = 17.f;
 
+/// Share of a light's specular reflection the highlight ks (N.H)^n carries at normal incidence:
+/// normalised Blinn-Phong is (n + 8) / (8 pi) (N.H)^n (Akenine-Moller et al., Real-Time
+/// Rendering), so the unnormalised lobe brings 8 / (n + 8) of it (0.9 at n = 1, 0.08 % at 10000).
+inline float highlight_share(float n) { return 8.f / (std::max(n, 1.f) + 8.f); }
+
 /// kd (N.L) + ks (N.H)^n for unit N, L (toward the light) and V (toward the viewer), n_dot_l = N.L > 0.
 inline Color local_term(const WhittedCoeffs& c, const Vec3f& N, const Vec3f& L, const Vec3f& V, float n_dot_l) {
     Color term = c.kd * n_dot_l;

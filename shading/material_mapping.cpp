@@ -95,8 +95,12 @@ WhittedCoeffs map_gltf_material(const Material& material, const PbrSample& sampl
     const float max_exponent = std::max(1.f, options.max_exponent);
     c.n = std::clamp(2.f / (alpha * alpha) - 2.f, 1.f, max_exponent);
 
-    // Mirror reflection only for smooth surfaces, faded out towards the cutoff.
-    c.kr = f0 * mirror_fade(roughness, options.mirror_roughness_cutoff);
+    // Mirror reflection only for smooth surfaces, faded out towards the cutoff; what the mirror
+    // term gives up is the glossy weight (the environment prefiltered by roughness).
+    const float fade = mirror_fade(roughness, options.mirror_roughness_cutoff);
+    c.kr = f0 * fade;
+    c.kg = f0 * (1.f - fade);
+    c.roughness = roughness;
 
     // Thin-walled unless KHR_materials_volume gives the material an inside; --refract-thin
     // refracts every transmissive material (decided per material so all its points agree).

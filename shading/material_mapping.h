@@ -39,11 +39,12 @@ struct PbrSample {
 ///   kd = baseColor (1 - m)(1 - t)(1 - max F0d);  ka = kd * occlusion
 ///   ks = F0, n = 2/alpha^2 - 2 with alpha = max(r^2, 1e-3), clamped to [1, max_exponent]
 ///   kr = F0 * fade(r), fade = 1 - smoothstep(0, mirror_roughness_cutoff, r)
+///   kg = F0 * (1 - fade(r)), roughness = r (the glossy reflection of the environment)
 ///   kt = baseColor (1 - m) t (1 - max F0d)      (= t (1 - F0) baseColor for a dielectric)
 ///   thin unless KHR_materials_volume (or options.refract_thin for transmissive materials);
 ///   absorption = -ln(attenuationColor) / attenuationDistance inside a volume
 ///   emission = sample.emissive
-/// Per channel ks + kt <= 1 and kd + kr + kt <= 1. Unlit materials return emission = baseColor
+/// Per channel ks + kt <= 1, kr + kg = ks and kd + kr + kg + kt <= 1. Unlit materials return emission = baseColor
 /// and every other coefficient 0; MaterialModel::Classic returns material.classic unchanged.
 WhittedCoeffs map_gltf_material(const Material& material, const PbrSample& sample, const MappingOptions& options);
 

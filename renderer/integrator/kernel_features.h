@@ -13,7 +13,8 @@ struct IntegratorSettings;
 /// The compile-time feature set of a shading kernel (one instantiation per combination used).
 struct KernelFeatures {
     bool attributes = true;    ///< UVs, vertex colors, ray-cone footprints, per-hit material evaluation
-    bool mirror = true;        ///< reflection rays (also total internal reflection)
+    bool mirror = true;        ///< reflection rays (also total internal reflection); the environment's
+                               ///< glossy term kg G casts no ray and is in every kernel
     bool transmission = true;  ///< refraction, alpha blend, absorption, shadow transmittance products
     bool tables = false;       ///< constant materials from a table, per-object light lists
     constexpr bool operator==(const KernelFeatures&) const = default;

@@ -61,16 +61,18 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
     Color I = c.emission;
     const bool unlit = s.mat.model == MaterialModel::GltfPbr && s.mat.unlit;  // KHR_materials_unlit
     if (!unlit) {
-        // I = emission + Ia ka + sum_i Is_i fat_i s_i (kd N.L_i + ks (N.H_i)^n) + kt T + kr R
+        // I = emission + Ia ka + sum_i Is_i fat_i s_i (kd N.L_i + ks (N.H_i)^n) + kt T + kr R + kg G
         I = direct_light<K>(I + ambient_light(s) * c.ka, s, counters);
-        if constexpr (K.mirror || K.transmission) {
-            if (depth < m_settings.max_depth) {
+        if (depth < m_settings.max_depth) {
+            Color kt_T(0.f), kr_R(0.f);
+            if constexpr (K.mirror || K.transmission) {
                 auto [kr, kt] = secondary_weights(c.ks, c.kr, c.kt, std::clamp(dot(s.f.N, s.f.V), 0.f, 1.f),
                                                   m_settings.fresnel);
-                const Color kt_T = transmitted<K>(s, kt, kr, counters);  // total internal reflection adds kt to kr
-                const Color kr_R = reflected<K>(s, kr, counters);
-                I = I + kt_T + kr_R;
+                kt_T = transmitted<K>(s, kt, kr, counters);  // total internal reflection adds kt to kr
+                kr_R = reflected<K>(s, kr, counters);
             }
+            const Color kg_G = glossy(s, counters);  // in every kernel: rough opaque scenes cast no mirror rays
+            I = I + kt_T + kr_R + kg_G;
         }
     }
     if constexpr (K.transmission) I = blend_behind<K>(s, absorbed(s, I), counters);
@@ -203,6 +205,21 @@ Color WhittedIntegrator::reflected(const Shading& s, const Color& kr, RayCounter
     if (is_black(kr) || !worth_tracing(w, counters)) return Color(0.f);
     const Ray r = spawn_ray(m_offset, s.sp, s.f.Ng, mirror_direction(s.f.V, s.f.N, s.f.Ng));
     return kr * trace<K>(r, RayKind::Reflection, s.depth + 1, counters, nullptr, s.secondary, w);
+}
+
+// ---- Glossy reflection of the environment: kg G ----------------------------------------------
+
+/// kg G: the split-sum prefilter (Karis 2013) about the mirror direction, the reflection the
+/// mirror term gives up on rough surfaces. The lights extracted from the map already reflect
+/// highlight_share(n) of their light as highlights, so that share of the extracted part is read
+/// from the residual instead of the map. It sees the environment only, never the scene's geometry.
+Color WhittedIntegrator::glossy(const Shading& s, RayCounters& counters) const {
+    if (!m_environment || is_black(s.c.kg)) return Color(0.f);
+    if (!worth_tracing(s.weight * max_component(s.c.kg), counters)) return Color(0.f);
+    const Vec3f R = mirror_direction(s.f.V, s.f.N, s.f.Ng);
+    const Color G = m_environment->prefiltered(R, s.c.roughness);
+    if (!m_environment->has_residual()) return s.c.kg * G;
+    return s.c.kg * lerp(G, m_environment->residual_prefiltered(R, s.c.roughness), highlight_share(s.c.n));
 }
 
 // ---- Media and coverage: absorption, alpha blend ------------------------------------------------

@@ -1,7 +1,10 @@
 // The Whitted (1980) ray tree: at the nearest hit the local model plus recursive reflection and
 // refraction, to a maximum depth (docs/integrator.md).
 //
-//   I = emission + Ia ka + sum_i Is_i fat_i s_i (kd N.L_i + ks (N.H_i)^n) + kt T + kr R
+//   I = emission + Ia ka + sum_i Is_i fat_i s_i (kd N.L_i + ks (N.H_i)^n) + kt T + kr R + kg G
+//
+// kg G, the glossy reflection of an environment (no ray: the prefiltered map), is the extension
+// for surfaces too rough for the mirror term (docs/environment.md).
 //
 // The shading code is a template on KernelFeatures (kernel_features.h): each render runs the
 // smallest instantiation its scene needs, so the hot path carries no per-ray feature branches.
@@ -116,6 +119,9 @@ private:
     Color transmitted(const Shading& s, const Color& kt, Color& kr, RayCounters& counters) const;
     template <KernelFeatures K>
     Color reflected(const Shading& s, const Color& kr, RayCounters& counters) const;
+    /// kg G: the environment prefiltered by the roughness about the mirror direction (0 without
+    /// an environment); no ray is traced, so it sees no geometry.
+    Color glossy(const Shading& s, RayCounters& counters) const;
     Color absorbed(const Shading& s, Color radiance) const;
     /// s_i: the light's visibility from the shadow-ray origin (transmittance through transparent occluders).
     Color shadow_factor(const Light& light, const LightSample& ls, const Vec3f& org, RayCounters& counters) const;

@@ -37,6 +37,10 @@ struct Environment {
     /// The light not extracted as lights, as radiance SH coefficients (bands 0-2, world space;
     /// shading/environment_map.h): the ambient term. Set by the importer with the lights.
     std::optional<std::array<Color, 9>> ambient_sh;
+    /// Luminance above which texels were extracted as lights, set by the importer with the lights
+    /// (infinite: nothing extracted). The residual scales each texel by min(1, threshold / luminance);
+    /// rough reflections read it where the lights' highlights bring the rest (docs/environment.md).
+    float extraction_threshold = kInfinity;
 };
 
 }  // namespace whitted

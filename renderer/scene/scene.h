@@ -152,6 +152,9 @@ struct WhittedCoeffs {
     float n = 1.f;                    ///< highlight exponent
     Color kr{0.f};                    ///< mirror reflection weight (Whitted's (1980) Ks on R)
     Color kt{0.f};                    ///< transmission weight (Whitted's (1980) Kt on T)
+    Color kg{0.f};                    ///< glossy reflection weight: the environment prefiltered by `roughness`
+                                      ///< about R (the extension for surfaces too rough for kr; 0 for classic materials)
+    float roughness = 0.f;            ///< GGX roughness of the glossy reflection, [0, 1]
     float ior = 1.5f;                 ///< index of refraction of the inside medium
     bool thin = true;                 ///< thin-walled: transmitted rays go straight through
     Color emission{0.f};              ///< emitted radiance added as is

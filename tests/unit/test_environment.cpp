@@ -180,6 +180,35 @@ TEST(Environment, SunBecomesOneLight) {
     for (const ExtractedLight& l : many.lights) EXPECT_LT(angle_between(l.direction, centroid), 2.f * texel);
 }
 
+// The residual the lights leave: the sun capped at the threshold's luminance, with its own
+// pyramid and prefilter; camera rays still see the whole sun. Nothing extracted: one pyramid.
+TEST(Environment, ResidualIsWhatTheLightsLeave) {
+    Environment env = sun_environment();
+    const EnvironmentMap full(env, 1);
+    EXPECT_FALSE(full.has_residual());
+    const EnvironmentLighting lighting = full.split(1);
+    env.extraction_threshold = lighting.threshold;
+    const EnvironmentMap map(env, 1);
+    ASSERT_TRUE(map.has_residual());
+    const Vec3f sun = texel_dir(kSunX, kSunY, kSunW, kSunH);
+    const float texel = float(kPi) / kSunH;  // a cone of one texel reads level 0
+    EXPECT_EQ(map.radiance(sun, texel), full.radiance(sun, texel));
+    EXPECT_GT(map.radiance(sun, texel).y, 0.2f * kSun);
+    EXPECT_LE(map.residual_radiance(sun, texel).y, lighting.threshold * 1.0001f);
+    EXPECT_GT(map.residual_radiance(sun, texel).y, 0.f);
+    // The residual's power is what split() left, and its prefilter holds only that.
+    EXPECT_LT(map.residual_prefiltered(sun, 0.5f).y, 1e-3f * map.prefiltered(sun, 0.5f).y);
+    EXPECT_GT(map.bytes(), full.bytes());
+    EXPECT_LE(map.bytes(), EnvironmentMap::estimated_bytes(map.width(), map.height()));
+    // Without a texel above the threshold the residual is the map, stored once.
+    Environment uniform = constant_environment(Color(0.5f));
+    uniform.extraction_threshold = 0.9f;
+    const EnvironmentMap same(uniform, 1);
+    EXPECT_FALSE(same.has_residual());
+    EXPECT_EQ(same.bytes(), EnvironmentMap(constant_environment(Color(0.5f)), 1).bytes());
+    EXPECT_EQ(same.residual_prefiltered(sun, 0.7f), same.prefiltered(sun, 0.7f));
+}
+
 // ---- rotation ----------------------------------------------------------------------------------
 
 TEST(Environment, RotationTurnsLightsAndLookups) {

@@ -151,6 +151,35 @@ TEST(MaterialMapping, MirrorFadesToZeroAtCutoff) {
     EXPECT_EQ(mirror_fade(0.f, 0.f), 0.f);
 }
 
+// What the mirror term gives up on rough surfaces is the glossy weight: kr + kg = F0 = ks at
+// every roughness, for metals and dielectrics; classic materials have no glossy term.
+TEST(MaterialMapping, GlossyTakesWhatTheMirrorGivesUp) {
+    for (const Material& base : {dielectric(Color(0.8f, 0.5f, 0.2f), 0.f), [] {
+             Material metal;
+             metal.base_color = {0.9f, 0.6f, 0.3f, 1.f};
+             metal.metallic = 1.f;
+             return metal;
+         }()}) {
+        for (int i = 0; i <= 20; ++i) {
+            Material m = base;
+            m.roughness = float(i) * 0.05f;
+            const WhittedCoeffs c = map_constant(m);
+            SCOPED_TRACE(testing::Message() << "metallic " << m.metallic << " roughness " << m.roughness);
+            EXPECT_COLOR_NEAR(c.kr + c.kg, c.ks, kEps);
+            EXPECT_EQ(c.roughness, m.roughness);
+            if (m.roughness >= 0.3f) EXPECT_COLOR_NEAR(c.kg, c.ks, 0.f);
+            if (m.roughness == 0.f) EXPECT_COLOR_NEAR(c.kg, Color(0.f), 0.f);
+        }
+    }
+    Material metal = dielectric(Color(0.9f, 0.6f, 0.3f), 1.f);
+    metal.metallic = 1.f;
+    EXPECT_COLOR_NEAR(map_constant(metal).kg, Color(0.9f, 0.6f, 0.3f), kEps);  // f0 = base colour
+    Material classic;
+    classic.model = MaterialModel::Classic;
+    classic.classic.kr = Color(0.5f);
+    EXPECT_COLOR_NEAR(map_constant(classic).kg, Color(0.f), 0.f);
+}
+
 TEST(MaterialMapping, RoughSceneNeverRecurses) {
     // Every material at or above the cutoff has kr = 0 whatever its other inputs.
     std::mt19937 rng(7);
@@ -289,7 +318,7 @@ TEST(MaterialMapping, EnergyConservedForRandomInputs) {
         for (int ch = 0; ch < 3; ++ch) {
             SCOPED_TRACE(testing::Message() << "sample " << i << " channel " << ch);
             EXPECT_LE(c.ks[ch] + c.kt[ch], 1.f + kEps);
-            EXPECT_LE(c.kd[ch] + c.kr[ch] + c.kt[ch], 1.f + kEps);
+            EXPECT_LE(c.kd[ch] + c.kr[ch] + c.kg[ch] + c.kt[ch], 1.f + kEps);
             EXPECT_LE(c.ka[ch], c.kd[ch] + kEps);
             for (float v : {c.kd[ch], c.ka[ch], c.ks[ch], c.kr[ch], c.kt[ch], c.absorption[ch]}) {
                 EXPECT_TRUE(std::isfinite(v));
