@@ -11,14 +11,6 @@
 
 namespace whitted {
 
-namespace {
-
-void add_warning(Scene& scene, const std::string& w) {
-    if (std::find(scene.warnings.begin(), scene.warnings.end(), w) == scene.warnings.end()) scene.warnings.push_back(w);
-}
-
-}  // namespace
-
 void setup_environment(Scene& scene, const ImportOptions& options) {
     if (options.no_environment) {
         scene.environment.reset();
@@ -30,7 +22,7 @@ void setup_environment(Scene& scene, const ImportOptions& options) {
         auto image = std::make_shared<EnvironmentImage>(load_environment_image(path, options.max_memory, warnings));
         for (const std::string& w : warnings)
             if (is_bundled_environment(path)) log_info("{}", w);
-            else add_warning(scene, w);
+            else scene.warn(w);
         Environment env;
         env.image = std::move(image);
         scene.environment = std::move(env);
@@ -44,7 +36,7 @@ void setup_environment(Scene& scene, const ImportOptions& options) {
     // lights replace the default light a scene without lights was given. The split reads the
     // full map, so no residual is built for it.
     env.extraction_threshold = kInfinity;
-    const EnvironmentMap map(env);
+    const EnvironmentMap map(env, 0, EnvironmentMap::Use::SplitOnly);
     const EnvironmentLighting lighting = map.split(std::max(options.environment_lights, 0));
     std::erase_if(scene.lights, [](const Light& l) { return l.is_default; });
     for (size_t k = 0; k < lighting.lights.size(); ++k) {

@@ -395,7 +395,9 @@ Light to_directional_light(const ExtractedLight& light, const std::string& name)
 
 // ---- the map ----------------------------------------------------------------------------------
 
-EnvironmentMap::EnvironmentMap(const Environment& env, int threads) {
+EnvironmentMap::EnvironmentMap(const Environment& env, int threads) : EnvironmentMap(env, threads, Use::Rendering) {}
+
+EnvironmentMap::EnvironmentMap(const Environment& env, int threads, Use use) {
     if (!env.image || env.image->width < 1 || env.image->height < 1 ||
         env.image->texels.size() != size_t(env.image->width) * size_t(env.image->height))
         throw Error(fmt::format("environment map '{}' has no texels", env.image ? env.image->name : std::string()));
@@ -444,7 +446,8 @@ EnvironmentMap::EnvironmentMap(const Environment& env, int threads) {
         m_residual = pyramid(std::move(residual));
     }
 
-    // The GGX prefilter of the map and of the residual.
+    // The GGX prefilter of the map and of the residual (not needed to split the light).
+    if (use == Use::SplitOnly) return;
     WorkerPool pool(threads);
     m_prefiltered = prefilter(m_levels, pool);
     if (!m_residual.empty()) m_residual_prefiltered = prefilter(m_residual, pool);
@@ -481,6 +484,7 @@ Color EnvironmentMap::residual_prefiltered(const Vec3f& dir, float roughness) co
 
 Color EnvironmentMap::lookup_prefiltered(const std::vector<Level>& pyramid, const std::vector<Level>& prefiltered,
                                          const Vec3f& dir, float roughness) const {
+    RT_CHECK(!prefiltered.empty());  // a Use::SplitOnly map has none
     if (!is_finite(dir)) return Color(0.f);
     const Vec3f d = map_from_world(dir);
     const Vec2f uv = latlong_uv(d);

@@ -88,6 +88,10 @@ public:
     /// (0 = all hardware threads; the result is the same for any count).
     /// Throws whitted::Error when env.image is null or empty.
     explicit EnvironmentMap(const Environment& env, int threads = 0);
+    /// What a map is built for: rendering (every lookup), or only split() (no prefiltered levels:
+    /// prefiltered() and residual_prefiltered() must not be called).
+    enum class Use { Rendering, SplitOnly };
+    EnvironmentMap(const Environment& env, int threads, Use use);
 
     /// Radiance arriving from world direction `dir` (any length; non-finite gives 0), filtered
     /// over a cone of full apex angle `cone_angle` radians: trilinear between MIP levels of the
