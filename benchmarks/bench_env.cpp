@@ -55,8 +55,7 @@ struct BenchEnvOptions {
     int threads = 0;                                       ///< 0 = all cores
     std::string timing = "cpu";                            ///< "cpu": process CPU time, "wall": the render's wall time
     std::string aa = "center";                             ///< anti-aliasing mode: one centre ray keeps the error the lighting's
-    float min_weight = 0.f;                                ///< 0: every light traced, the error is the split's alone;
-                                                           ///< `render`'s 1/255 drops the lights too dim at a point
+    float min_weight = 1.f / 255.f;                        ///< `render`'s default: what a user gets (0: every light's shadow traced)
     std::vector<std::string> overhead_scenes;              ///< scenes of the lookup-cost measurement; empty = the bundled ones
     int overhead_repeat = 7;                               ///< timed runs per scene and variant (interleaved); the median is reported
     bool overhead = true;                                  ///< measure the lookup cost at all
@@ -375,7 +374,7 @@ Command register_bench_env(CLI::App& bench) {
     app->add_option("--aa", o->aa, "Anti-aliasing mode of every render")
         ->check(CLI::IsMember({"center", "corners", "adaptive", "stratified"}))->capture_default_str();
     app->add_option("--min-weight", o->min_weight, "Lights and secondary rays below this weight are not traced "
-                    "(as `whitted render --min-weight`; 0 = all, so the error is the split's alone)")->check(CLI::Range(0.0, 1.0))->capture_default_str();
+                    "(as `whitted render --min-weight`, whose default this is; 0 = every shadow ray)")->check(CLI::Range(0.0, 1.0))->capture_default_str();
     app->add_option("--overhead-scenes", o->overhead_scenes, "Scenes of the lookup-cost measurement (default: "
                     "assets/scenes/*.json and default.glb)");
     app->add_option("--overhead-repeat", o->overhead_repeat, "Timed runs per scene and variant of the lookup-cost "

@@ -319,11 +319,36 @@ std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::L
 
 // ---- lat-long parameterisation ----------------------------------------------------------------
 
+namespace {
+
+/// atan(x) for x in [0, 1]: an odd polynomial of degree 11, within 3.3e-6 rad of std::atan (a
+/// lat-long texel of a 1024-wide map spans 6e-3 rad), scaled to be pi/4 at x = 1 so that the two
+/// octants meeting on a diagonal agree (no step of the lookup there); a fraction of the cost of
+/// atan2f and acosf.
+float atan_unit(float x) {
+    const float x2 = x * x;
+    return x * (0.99997938f +
+                x2 * (-0.33262417f + x2 * (0.19354387f + x2 * (-0.11643312f + x2 * (0.05265343f + x2 * -0.01172122f)))));
+}
+
+/// atan2(y, x) from atan_unit, exact on the axes (0 at +x, pi/2 at +y, pi at -x).
+float fast_atan2(float y, float x) {
+    const float ax = std::fabs(x), ay = std::fabs(y);
+    const float hi = std::max(ax, ay), lo = std::min(ax, ay);
+    if (!(hi > 0.f)) return 0.f;
+    float a = atan_unit(lo / hi);
+    if (ay > ax) a = 0.5f * kPi - a;
+    if (x < 0.f) a = kPi - a;
+    return y < 0.f ? -a : a;
+}
+
+}  // namespace
+
 Vec2f latlong_uv(const Vec3f& d) {
     const float len = length(d);
     if (!(len > 0.f) || !std::isfinite(len)) return {0.5f, 0.5f};
-    const float u = 0.5f + std::atan2(d.z, d.x) / (2.f * kPi);
-    const float v = std::acos(std::clamp(d.y / len, -1.f, 1.f)) / kPi;
+    const float u = 0.5f + fast_atan2(d.z, d.x) / (2.f * kPi);
+    const float v = fast_atan2(std::sqrt(d.x * d.x + d.z * d.z), d.y) / kPi;  // acos(d.y / len)
     return {std::clamp(u, 0.f, 1.f), std::clamp(v, 0.f, 1.f)};
 }
 
@@ -339,7 +364,9 @@ Color EnvironmentMap::Level::bilinear(float u, float v) const {
     const float x = u * float(width) - 0.5f;
     const float fx0 = std::floor(x);
     const float fx = x - fx0;
-    const int xa = ((int(fx0) % width) + width) % width, xb = (xa + 1) % width;
+    int xa = int(fx0);
+    if (xa < 0 || xa >= width) xa = ((xa % width) + width) % width;
+    const int xb = xa + 1 == width ? 0 : xa + 1;
     auto row = [&](int y) {
         const Color* r = &texels[size_t(y) * size_t(width)];
         return lerp(r[xa], r[xb], fx);
@@ -353,27 +380,6 @@ Color EnvironmentMap::Level::bilinear(float u, float v) const {
 }
 
 // ---- SH9 ----------------------------------------------------------------------------------------
-
-std::array<float, 9> sh9_basis(const Vec3f& d) {
-    return {0.282094792f,
-            0.488602512f * d.y,
-            0.488602512f * d.z,
-            0.488602512f * d.x,
-            1.092548431f * d.x * d.y,
-            1.092548431f * d.y * d.z,
-            0.315391565f * (3.f * d.z * d.z - 1.f),
-            1.092548431f * d.x * d.z,
-            0.546274215f * (d.x * d.x - d.y * d.y)};
-}
-
-Color sh9_irradiance(const SH9& sh, const Vec3f& n) {
-    // Ramamoorthi & Hanrahan (2001): E(n) = sum_lm A_l L_lm Y_lm(n), A = (pi, 2pi/3, pi/4); / pi.
-    constexpr std::array<float, 9> a_over_pi{1.f, 2.f / 3.f, 2.f / 3.f, 2.f / 3.f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f};
-    const std::array<float, 9> y = sh9_basis(n);
-    Color e(0.f);
-    for (size_t i = 0; i < 9; ++i) e += sh[i] * (a_over_pi[i] * y[i]);
-    return vmax(e, Color(0.f));
-}
 
 Color EnvironmentLighting::irradiance(const Vec3f& n) const {
     Color e = residual_irradiance(n);
@@ -463,13 +469,13 @@ Vec3f EnvironmentMap::map_from_world(const Vec3f& d) const {
 
 Color EnvironmentMap::radiance(const Vec3f& dir, float cone_angle) const {
     if (!is_finite(dir)) return Color(0.f);
-    const float lod = cone_angle > 0.f ? std::log2(cone_angle / m_texel_angle) : 0.f;
+    const float lod = cone_angle > m_texel_angle ? std::log2(cone_angle / m_texel_angle) : 0.f;
     return sample_pyramid(m_levels, map_from_world(dir), lod);
 }
 
 Color EnvironmentMap::residual_radiance(const Vec3f& dir, float cone_angle) const {
     if (!is_finite(dir)) return Color(0.f);
-    const float lod = cone_angle > 0.f ? std::log2(cone_angle / m_texel_angle) : 0.f;
+    const float lod = cone_angle > m_texel_angle ? std::log2(cone_angle / m_texel_angle) : 0.f;
     return sample_pyramid(residual_levels(), map_from_world(dir), lod);
 }
 
@@ -498,17 +504,13 @@ Color EnvironmentMap::lookup_prefiltered(const std::vector<Level>& pyramid, cons
     return lerp(prefiltered[k - 1].bilinear(uv.x, uv.y), prefiltered[k].bilinear(uv.x, uv.y), std::clamp(f, 0.f, 1.f));
 }
 
-float split_threshold_factor(int n_lights) {
-    return n_lights > 0 ? std::max(2.f / std::sqrt(float(n_lights)), 1.f / 16.f) : 2.f;
-}
-
 EnvironmentLighting EnvironmentMap::split(const SplitSettings& settings) const {
     const ScopedFlushDenormals ftz;
     const Level& base = m_levels.front();
     const int w = base.width, h = base.height;
     EnvironmentLighting out;
     const bool extract = settings.lights > 0;
-    const float factor = settings.threshold_factor > 0.f ? settings.threshold_factor : split_threshold_factor(settings.lights);
+    const float factor = settings.threshold_factor;
     // Never below the dimmest texel: light common to every direction is a constant, which the
     // ambient holds exactly and point lights only approximate (a uniform map stays all ambient).
     double dimmest = kInfinity;

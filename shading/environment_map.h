@@ -22,10 +22,17 @@
 namespace whitted {
 
 /// Number of extracted lights when the caller does not choose (ImportOptions::environment_lights,
-/// --env-lights): each costs a shadow ray per shaded point. At 16 the lights plus the ambient give
-/// the map's irradiance within 6-7 % at the 6 axis normals of studio and courtyard (2 % needs 128:
-/// docs/measurements/environment.md); `whitted bench env` measures the image error per count.
-constexpr int kDefaultEnvironmentLights = 16;
+/// --env-lights): the fewest of 0, 1, 4, 16, 64, 256 whose display image `whitted bench env` finds
+/// within 1/255 (RMSE) of 1024 lights on every asset and map it renders (64: 1.65/255 off on
+/// default.glb under courtyard). Each costs at most a shadow ray per shaded point (fewer where the
+/// adaptive shadow test stops); the lights plus the ambient give the map's irradiance within 1.2 %
+/// at the 6 axis normals of studio and courtyard (docs/measurements/environment.md).
+constexpr int kDefaultEnvironmentLights = 256;
+/// Texels brighter than this times the map's mean luminance give their excess to the extracted
+/// lights, whatever their number: the ambient, which nothing shadows, keeps at most 1/16 of the
+/// map's light, and N lights against more differ only in how they divide the same light
+/// (docs/environment.md "How the light is split").
+constexpr float kExtractionThresholdFactor = 1.f / 16.f;
 /// Roughness of the stored prefiltered levels; roughness 0 is the map itself.
 constexpr std::array<float, 4> kPrefilterRoughness{0.25f, 0.5f, 0.75f, 1.f};
 
@@ -34,12 +41,29 @@ constexpr std::array<float, 4> kPrefilterRoughness{0.25f, 0.5f, 0.75f, 1.f};
 using SH9 = std::array<Color, 9>;
 
 /// The 9 real SH basis functions at the unit direction d.
-std::array<float, 9> sh9_basis(const Vec3f& d);
+inline std::array<float, 9> sh9_basis(const Vec3f& d) {
+    return {0.282094792f,
+            0.488602512f * d.y,
+            0.488602512f * d.z,
+            0.488602512f * d.x,
+            1.092548431f * d.x * d.y,
+            1.092548431f * d.y * d.z,
+            0.315391565f * (3.f * d.z * d.z - 1.f),
+            1.092548431f * d.x * d.z,
+            0.546274215f * (d.x * d.x - d.y * d.y)};
+}
 
 /// Irradiance from radiance SH coefficients at unit normal n, divided by pi (renderer units:
 /// a constant radiance L gives L), with Ramamoorthi & Hanrahan's cosine-lobe constants
 /// A0 = pi, A1 = 2pi/3, A2 = pi/4; clamped at 0.
-Color sh9_irradiance(const SH9& sh, const Vec3f& n);
+/// Inline: the ambient of every shaded point under an environment.
+inline Color sh9_irradiance(const SH9& sh, const Vec3f& n) {
+    constexpr std::array<float, 9> a_over_pi{1.f, 2.f / 3.f, 2.f / 3.f, 2.f / 3.f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f};
+    const std::array<float, 9> y = sh9_basis(n);
+    Color e(0.f);
+    for (size_t i = 0; i < 9; ++i) e += sh[i] * (a_over_pi[i] * y[i]);
+    return vmax(e, Color(0.f));
+}
 
 /// One light cut from the environment's brightest part (one median-cut region).
 struct ExtractedLight {
@@ -69,13 +93,10 @@ struct EnvironmentLighting {
 /// How EnvironmentMap::split() divides the light.
 struct SplitSettings {
     int lights = kDefaultEnvironmentLights;  ///< at most this many extracted lights; 0 = everything is ambient
-    float threshold_factor = 0.f;            ///< threshold T = max(factor * mean luminance, dimmest texel's); 0 = split_threshold_factor(lights)
+    float threshold_factor = kExtractionThresholdFactor;  ///< threshold T = max(factor * mean luminance, dimmest texel's)
     bool correct_ambient = true;             ///< the ambient's bands 1-2 absorb the lights' own error in those bands
 };
 
-/// The threshold factor split() uses by default: 2 / sqrt(n_lights), at least 1/16 (T falls
-/// as the lights get finer; docs/environment.md "How the light is split").
-float split_threshold_factor(int n_lights);
 
 /// A directional Light for an extracted light: travel direction -direction, colour
 /// intensity / max component, intensity its max component, no attenuation.

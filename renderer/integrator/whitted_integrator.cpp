@@ -94,13 +94,37 @@ Color WhittedIntegrator::ambient_light(const Shading& s) const {
 // ---- Direct light: sum_i Is_i fat_i s_i (kd N.L_i + ks (N.H_i)^n) --------------------------
 
 /// `sum` plus the light of every light source at the point; the terms are added to `sum` in light
-/// order. A light casts no shadow ray where it cannot reach the point, faces it from behind, or
-/// gives it nothing for the shadow factor to scale.
+/// order, the scene's own lights first, then those extracted from the environment (below). A light
+/// casts no shadow ray where it cannot reach the point, faces it from behind, or gives it nothing
+/// for the shadow factor to scale.
+///
+/// The extracted lights are many dim ones, so they take Ward's adaptive shadow testing (Ward,
+/// "Adaptive Shadow Testing for Ray Tracing", 1991): sorted by what each could give the point
+/// unshadowed, shadow rays are traced from the brightest down until what the untested ones could
+/// still add, times the path weight, is below min_weight; the untested ones then add their
+/// unshadowed light scaled by the fraction the tested ones let through. Nothing is dropped: with
+/// min_weight = 0 every light is tested.
 template <KernelFeatures K>
 Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& counters) const {
     const WhittedCoeffs& c = s.c;
     if (is_black(c.kd) && is_black(c.ks)) return sum;
     std::optional<Vec3f> shadow_org;  // computed at the first light that needs a shadow ray
+    struct Candidate {
+        const Light* light;
+        LightSample ls;
+        Color potential;  // Is fat (kd N.L + ks (N.H)^n): the light's term if nothing shadows it
+        float key;
+    };
+    thread_local std::vector<Candidate> environment;
+    environment.clear();
+    auto shadowed = [&](const Candidate& e) {
+        if (!shadow_org) shadow_org = m_offset.origin(s.f.front ? s.sp.p_shadow : s.sp.p, s.sp.offset_scale, s.f.Ng);
+        const Color shadow = shadow_factor(*e.light, e.ls, *shadow_org, counters);
+        if (is_black(shadow)) return Color(0.f);
+        // Opaque scenes: the shadow factor is exactly 1 here, and x * 1 == x.
+        if constexpr (K.transmission) return e.potential * shadow;
+        else return e.potential;
+    };
     auto add_light = [&](const Light& light) {
         const LightSample ls = sample_light(light, s.sp.p);
         if (is_black(ls.intensity)) {  // beyond its range window or outside its spot cone
@@ -113,24 +137,15 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
             ++counters.shadow_skipped_facing;
             return;
         }
-        const Color term = local_term(c, s.f.N, ls.L, s.f.V, n_dot_l);
+        const Color term = local_term(c, s.f.N, ls.L, s.f.V, n_dot_l,
+                                      light.from_environment ? environment_highlight_scale(c.n) : 1.f);
         if (is_black(term)) {  // kd = 0 and the highlight below its cutoff
             ++counters.shadow_skipped_zero;
             return;
         }
-        // One of the many lights cut from the environment, too dim here to matter: all of them
-        // together that are skipped at this point stay below min_weight.
-        if (light.from_environment &&
-            s.weight * max_component(ls.intensity * term) * m_environment_lights < m_settings.min_weight) {
-            ++counters.shadow_skipped_dim;
-            return;
-        }
-        if (!shadow_org) shadow_org = m_offset.origin(s.f.front ? s.sp.p_shadow : s.sp.p, s.sp.offset_scale, s.f.Ng);
-        const Color shadow = shadow_factor(light, ls, *shadow_org, counters);
-        if (is_black(shadow)) return;
-        // Opaque scenes: the shadow factor is exactly 1 here, and x * 1 == x.
-        if constexpr (K.transmission) sum += ls.intensity * shadow * term;
-        else sum += ls.intensity * term;
+        const Candidate e{&light, ls, ls.intensity * term, 0.f};
+        if (light.from_environment) environment.push_back({e.light, e.ls, e.potential, max_component(e.potential)});
+        else sum += shadowed(e);
     };
     if constexpr (K.tables) {
         // Only the lights that can reach this object (SceneAnalysis light reach).
@@ -140,7 +155,32 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
     } else {
         for (const Light& light : m_view.scene().lights) add_light(light);
     }
-    return sum;
+    if (environment.empty()) return sum;
+
+    // Brightest first; ties in light order, so the result does not depend on the sort.
+    std::sort(environment.begin(), environment.end(), [](const Candidate& a, const Candidate& b) {
+        return a.key != b.key ? a.key > b.key : a.light < b.light;
+    });
+    Color untested(0.f);
+    for (const Candidate& e : environment) untested += e.potential;
+    Color tested(0.f), passed(0.f);
+    size_t i = 0;
+    for (; i < environment.size() && s.weight * max_component(untested) >= m_settings.min_weight; ++i) {
+        const Color through = shadowed(environment[i]);
+        passed += through;
+        tested += environment[i].potential;
+        untested = untested - environment[i].potential;
+        untested = Color(std::max(untested.x, 0.f), std::max(untested.y, 0.f), std::max(untested.z, 0.f));
+    }
+    sum += passed;
+    if (i == environment.size()) return sum;
+    counters.shadow_skipped_dim += environment.size() - i;
+    untested = Color(0.f);  // summed again: the running difference above is not exact
+    for (size_t j = i; j < environment.size(); ++j) untested += environment[j].potential;
+    if (i == 0) return sum + untested;  // all of them together below min_weight: unshadowed
+    const Color let_through(tested.x > 0.f ? passed.x / tested.x : 1.f, tested.y > 0.f ? passed.y / tested.y : 1.f,
+                            tested.z > 0.f ? passed.z / tested.z : 1.f);
+    return sum + untested * let_through;
 }
 
 Color WhittedIntegrator::shadow_factor(const Light& light, const LightSample& ls, const Vec3f& org,
@@ -376,7 +416,6 @@ WhittedIntegrator::WhittedIntegrator(const SceneView& view, const Accelerator& a
     pick(std::make_index_sequence<std::size(kKernels)>{});
     RT_CHECK(m_trace != nullptr);
     m_environment = view.environment();
-    for (const Light& l : view.scene().lights) m_environment_lights += l.from_environment ? 1.f : 0.f;
     const std::optional<Environment>& env = view.scene().environment;
     if (env && env->ambient_sh && settings.environment_ambient) m_ambient_sh = &*env->ambient_sh;
     if (m_kernel.transmission) {

@@ -159,7 +159,6 @@ private:
     KernelFeatures m_kernel;
     const EnvironmentMap* m_environment = nullptr;             ///< null: misses see the background
     const std::array<Color, 9>* m_ambient_sh = nullptr;        ///< null: the constant ambient
-    float m_environment_lights = 0.f;                          ///< lights extracted from the environment
     TraceFn m_trace = nullptr;          ///< trace<m_kernel>
     CameraFn m_trace_camera = nullptr;  ///< trace_camera<m_kernel>
     std::shared_ptr<const DielectricContacts> m_contacts;  ///< null when no dielectrics touch

@@ -145,10 +145,9 @@ TEST(Environment, SplitConservesPower) {
         EXPECT_GE(lum(sixteen.lights[k - 1].intensity), lum(sixteen.lights[k].intensity));
     EXPECT_TRUE(map.split(0).lights.empty());
     EXPECT_TRUE(std::isinf(map.split(0).threshold));
-    EXPECT_NEAR(sixteen.threshold, 0.5f * lum(map.mean()), 1e-5f * sixteen.threshold);  // 2 / sqrt(16)
-    EXPECT_FLOAT_EQ(split_threshold_factor(1), 2.f);
-    EXPECT_FLOAT_EQ(split_threshold_factor(64), 0.25f);
-    EXPECT_FLOAT_EQ(split_threshold_factor(100000), 1.f / 16.f);
+    // The same threshold for every light count: 1/16 of the mean (the map's dimmest texel is darker).
+    EXPECT_NEAR(sixteen.threshold, kExtractionThresholdFactor * lum(map.mean()), 1e-5f * sixteen.threshold);
+    EXPECT_FLOAT_EQ(map.split(256).threshold, sixteen.threshold);
 }
 
 // ---- a sun -------------------------------------------------------------------------------------
@@ -281,9 +280,8 @@ TEST(Environment, LightsPlusResidualReproduceIrradiance) {
             std::printf("[ irradiance ] %-9s %4d  %6zu  %8.2f  (%8.2f)  %12.2f\n", name.c_str(), n_lights,
                         lighting.lights.size(), 100.0 * worst, 100.0 * worst_plain,
                         100.0 * std::sqrt(squares / (3.0 * double(randoms.size()))));
-            // 128 lights reach 2 % at the axes; fewer (the default 16: 6-7 %) trade it for shadow rays.
-            if (n_lights >= 128) EXPECT_LT(worst, 0.02f) << name;
-            if (n_lights == kDefaultEnvironmentLights) EXPECT_LT(worst, 0.08f) << name;
+            // The requirement, at the default count (the one `whitted bench env` chose): 2 % at the axes.
+            if (n_lights >= kDefaultEnvironmentLights) EXPECT_LT(worst, 0.02f) << name;
         }
     }
 }
@@ -314,13 +312,16 @@ TEST(Environment, SeamAndPolesAreContinuous) {
     for (const float pole : {1.f, -1.f}) {
         const Color at_pole = map.radiance({0, pole, 0});
         ASSERT_TRUE(is_finite(at_pole));
-        float neighbour = 0.f;  // largest difference between neighbouring texels of the pole row
         const int row = pole > 0 ? 0 : img.height - 1;
-        for (int x = 0; x < img.width; ++x) neighbour = std::max(neighbour, max_abs(img.at(x, row) - img.at((x + 1) % img.width, row)));
+        // eps from the pole the lookup is a share 2 eps h / pi of the way from the pole's value to
+        // the pole row's (the blend over the last half texel): it converges, whatever the longitude.
+        float spread = 0.f;  // largest difference between the pole row and the pole's value
+        for (int x = 0; x < img.width; ++x) spread = std::max(spread, max_abs(img.at(x, row) - at_pole));
         for (int k = 0; k < 64; ++k) {
             const float phi = 2.f * kPi * k / 64.f, eps = 1e-4f;
             const Color near = map.radiance(normalize(Vec3f(eps * std::cos(phi), pole, eps * std::sin(phi))));
-            EXPECT_LE(max_abs(near - at_pole), std::max(0.01f * neighbour, 1e-6f)) << k;
+            const float share = 2.f * eps * float(img.height) / kPi;
+            EXPECT_LE(max_abs(near - at_pole), std::max(1.1f * share * spread, 1e-6f)) << k;
         }
     }
     // No NaN anywhere: random directions, the axes, unnormalized and degenerate input.
