@@ -58,10 +58,13 @@ inline std::array<float, 9> sh9_basis(const Vec3f& d) {
 /// A0 = pi, A1 = 2pi/3, A2 = pi/4; clamped at 0.
 /// Inline: the ambient of every shaded point under an environment.
 inline Color sh9_irradiance(const SH9& sh, const Vec3f& n) {
-    constexpr std::array<float, 9> a_over_pi{1.f, 2.f / 3.f, 2.f / 3.f, 2.f / 3.f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f};
-    const std::array<float, 9> y = sh9_basis(n);
-    Color e(0.f);
-    for (size_t i = 0; i < 9; ++i) e += sh[i] * (a_over_pi[i] * y[i]);
+    // sum_i sh[i] (A_l / pi) Y_i(n), the constants folded per band: A_l / pi = 1, 2/3, 1/4.
+    constexpr float c0 = 0.282094792f, c1 = 2.f / 3.f * 0.488602512f, c2 = 0.25f * 1.092548431f,
+                    c20 = 0.25f * 0.315391565f, c22 = 0.25f * 0.546274215f;
+    const float x = n.x, y = n.y, z = n.z;
+    const Color e = sh[0] * c0 + (sh[1] * y + sh[2] * z + sh[3] * x) * c1 +
+                    (sh[4] * (x * y) + sh[5] * (y * z) + sh[7] * (x * z)) * c2 + sh[6] * (c20 * (3.f * z * z - 1.f)) +
+                    sh[8] * (c22 * (x * x - y * y));
     return vmax(e, Color(0.f));
 }
 

@@ -127,8 +127,11 @@ TEST(EnvironmentRender, ConstantAmbientWhenGiven) {
     EXPECT_EQ(render(scene, constant).beauty[16 * 32 + 16], Color(0.25f));
 }
 
-// Extracted lights too dim to matter cast no shadow ray, and all of those skipped at a point stay
-// below min_weight: many lights at the CLI's 1/255 give the image of min_weight 0 within 1/255.
+// Ward's adaptive shadow testing of the extracted lights: shadow rays stop once what the untested
+// lights could still add is below min_weight, and those are added at the visibility of the tested
+// ones. So the CLI's 1/255 gives the image of min_weight 0 within 1/255 in every channel, with a
+// sphere shadowing a floor, while tracing fewer shadow rays; nothing is dropped (a lit point that
+// tested no light at all still gets its light).
 TEST(EnvironmentRender, DimLightsSkippedWithinMinWeight) {
     WhittedCoeffs white;
     white.kd = white.ka = Color(0.8f);
@@ -139,14 +142,27 @@ TEST(EnvironmentRender, DimLightsSkippedWithinMinWeight) {
     for (int y = 0; y < 32; ++y)
         for (int x = 0; x < 64; ++x) image->texels.push_back(Color(0.05f + 0.9f * float((x * 7 + y * 13) % 17) / 16.f));
     env.image = image;
-    const Scene scene = sphere_under(white, env, 256);
-    IntegratorSettings exact, cut;
-    cut.min_weight = 1.f / 255.f;
-    const Film a = render(scene, exact), b = render(scene, cut);
+    Scene scene = sphere_under(white, env, 1024);
+    add_mesh(scene, make_quad({-4, -1, -4}, {-4, -1, 4}, {4, -1, 4}, {4, -1, -4}, scene.spheres[0].material));
+    scene.cameras[0] = make_camera(CameraType::Perspective, {0, 1.5, 4}, normalize(Vec3d(0, -0.5, -1)), {0, 1, 0}, 0.9);
+    RenderSettings rs;
+    rs.width = rs.height = 32;
+    rs.threads = 1;
+    RenderStats exact_stats, cut_stats;
+    const Film a = Renderer(scene, rs).render(&exact_stats);
+    rs.integrator.min_weight = 1.f / 255.f;
+    const Film b = Renderer(scene, rs).render(&cut_stats);
     float worst = 0.f;
     for (size_t i = 0; i < a.beauty.size(); ++i)
         for (int k = 0; k < 3; ++k) worst = std::max(worst, std::fabs(a.beauty[i][k] - b.beauty[i][k]));
     EXPECT_LE(worst, 1.f / 255.f);
+    EXPECT_GT(worst, 0.f);  // the floor's shadow is estimated, not traced, for the untested lights
+    EXPECT_EQ(exact_stats.rays.shadow_skipped_dim, 0u);
+    EXPECT_GT(cut_stats.rays.shadow_skipped_dim, 0u);
+    EXPECT_LT(cut_stats.rays.shadow, exact_stats.rays.shadow);
+    std::printf("[ ward ] shadow rays %llu -> %llu, worst difference %.5f\n",
+                (unsigned long long)exact_stats.rays.shadow,
+                (unsigned long long)cut_stats.rays.shadow, double(worst));
 }
 
 // A rough metal (roughness 1, past the mirror cutoff) reflects the environment through the
