@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "benchmarks/bench_commands.h"
+#include "benchmarks/bench_images.h"
 #include "benchmarks/bench_timing.h"
 #include "benchmarks/ray_recording.h"
 #include "importers/scene_loader.h"
@@ -59,7 +60,7 @@ struct BenchAaOptions {
     bool replay = false;             ///< split the target runs' CPU time into ray trees and the rest (needs --threads 1)
     int target_search = 3;           ///< bisection steps of the threshold search at the target (0 = the sweep's settings only)
     bool plot = true;                ///< run scripts/plot_aa.py afterwards when possible
-    std::string python = "python3";  ///< interpreter with matplotlib for the plots
+    std::string python = default_python();  ///< interpreter with matplotlib for the plots
 };
 
 /// One benchmark run: the settings and what they measured.

@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "benchmarks/bench_commands.h"
+#include "benchmarks/bench_images.h"
 #include "benchmarks/bench_timing.h"
 #include "benchmarks/ray_recording.h"
 #include "importers/mesh_normals.h"
@@ -613,7 +614,7 @@ int run(BenchAccelOptions o) {
     // The plot: time per ray against triangle count, log-log (needs python3-matplotlib).
     const std::string script = std::string(WHITTED_SOURCE_DIR) + "/scripts/plot_accel.py";
     // Debian's interpreter (where python3-matplotlib installs), not whatever python3 is first on PATH.
-    const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+    const std::string python = default_python();
     const std::string cmd = fmt::format("{} '{}' '{}' '{}' 2>&1", python, script, csv_path, (fs::path(o.out) / "accel.png").string());
     if (std::system(cmd.c_str()) != 0)
         log_warning("bench accel: no plot (needs python3-matplotlib and a scene at two sizes; then run: python3 "

@@ -61,7 +61,7 @@ struct BenchEnvOptions {
     bool overhead = true;                                  ///< measure the lookup cost at all
     std::string out = "bench-env";                         ///< output directory (CSV, images, plot)
     bool plot = true;                                      ///< run scripts/plot_env.py afterwards when possible
-    std::string python = "python3";                        ///< interpreter with matplotlib for the plot
+    std::string python = default_python();                        ///< interpreter with matplotlib for the plot
 };
 
 /// Assets of the default run, under assets/gltf/<name>/glTF-Binary/<name>.glb, and the default scene.

@@ -48,6 +48,12 @@ inline double max_abs_difference(const std::vector<float>& a, const std::vector<
     return m;
 }
 
+/// Debian's interpreter, where the packages the set-up installs (python3-matplotlib) live, before
+/// whatever `python3` the PATH finds first (a pyenv or venv one may lack them).
+inline std::string default_python() {
+    return std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+}
+
 /// Runs `python scripts/<script> CSV OUT_DIR` when the interpreter has matplotlib; otherwise (or
 /// when the script fails) logs one warning with the command to run later. `bench` names the
 /// caller in the warning.

@@ -53,6 +53,7 @@
 #include <time.h>
 
 #include "benchmarks/bench_commands.h"
+#include "benchmarks/bench_images.h"
 #include "benchmarks/bench_timing.h"
 #include "benchmarks/ray_recording.h"
 #include "importers/scene_loader.h"
@@ -682,7 +683,7 @@ int run_bench_skip(const BenchSkipOptions& o) {
 
     if (o.plot) {
         const fs::path script = fs::path(WHITTED_SOURCE_DIR) / "scripts" / "plot_skip.py";
-        const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+        const std::string python = default_python();
         const std::string cmd = fmt::format("{} '{}' '{}' '{}'", python, script.string(), (out / "skip.csv").string(),
                                             (out / "skip_min_weight.png").string());
         if (std::system(cmd.c_str()) != 0) log_warning("bench skip: no plot (needs python3-matplotlib): {}", cmd);
