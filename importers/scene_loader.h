@@ -8,6 +8,7 @@
 #include <span>
 #include <string>
 
+#include "renderer/scene/environment.h"
 #include "renderer/scene/scene.h"
 
 namespace whitted {
@@ -28,8 +29,7 @@ struct ImportOptions {
     bool no_environment = false;                ///< no environment at all, whatever the file says
     bool default_environment = true;            ///< a glTF file with no lights and no environment is lit
                                                 ///< by the bundled studio map instead of the default light
-    int environment_lights = 16;                ///< lights extracted from it (0 = all of its light is ambient);
-                                                ///< = kDefaultEnvironmentLights (shading/environment_map.h)
+    int environment_lights = kDefaultEnvironmentLights;  ///< lights extracted from it (0 = all of its light is ambient)
 };
 
 /// Sets up the scene's environment after import: the one `options` names replaces the file's

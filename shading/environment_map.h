@@ -21,13 +21,6 @@
 
 namespace whitted {
 
-/// Number of extracted lights when the caller does not choose (ImportOptions::environment_lights,
-/// --env-lights): the fewest of 0, 1, 4, 16, 64, 256 whose display image `whitted bench env` finds
-/// within 1/255 (RMSE) of 1024 lights on every asset and map it renders (64: 1.65/255 off on
-/// default.glb under courtyard). Each costs at most a shadow ray per shaded point (fewer where the
-/// adaptive shadow test stops); the lights plus the ambient give the map's irradiance within 1.2 %
-/// at the 6 axis normals of studio and courtyard (docs/measurements/environment.md).
-constexpr int kDefaultEnvironmentLights = 256;
 /// Texels brighter than this times the map's mean luminance give their excess to the extracted
 /// lights, whatever their number: the ambient, which nothing shadows, keeps at most 1/16 of the
 /// map's light, and N lights against more differ only in how they divide the same light
