@@ -1,6 +1,8 @@
 #include "renderer/film/film.h"
 
+#include <algorithm>
 #include <bit>
+#include <cstddef>
 #include <cstdint>
 
 #include "renderer/core/error.h"
@@ -49,6 +51,39 @@ size_t zero_nonfinite(std::vector<V>& buffer) {
 }
 
 }  // namespace
+
+bool Film::can_paste(const Film& part) const {
+    const PixelWindow& w = part.window;
+    return part.full_width == full_width && part.full_height == full_height && w.x0 >= window.x0 &&
+           w.y0 >= window.y0 && w.x1 <= window.x1 && w.y1 <= window.y1 && w.width() > 0 && w.height() > 0 &&
+           part.aovs.depth == aovs.depth && part.aovs.normal == aovs.normal && part.aovs.albedo == aovs.albedo &&
+           part.aovs.prim_id == aovs.prim_id && part.aovs.inst_id == aovs.inst_id &&
+           part.aovs.aa_samples == aovs.aa_samples;
+}
+
+namespace {
+
+template <typename T>
+void paste_rows(std::vector<T>& dst, const Film& to, const std::vector<T>& src, const Film& from) {
+    if (src.empty()) return;
+    const PixelWindow& w = from.window;
+    for (int y = w.y0; y < w.y1; ++y)
+        std::copy_n(src.begin() + std::ptrdiff_t(from.index(w.x0, y)), w.width(),
+                    dst.begin() + std::ptrdiff_t(to.index(w.x0, y)));
+}
+
+}  // namespace
+
+void Film::paste(const Film& part) {
+    RT_CHECK(can_paste(part));
+    paste_rows(beauty, *this, part.beauty, part);
+    paste_rows(depth, *this, part.depth, part);
+    paste_rows(normal, *this, part.normal, part);
+    paste_rows(albedo, *this, part.albedo, part);
+    paste_rows(prim_id, *this, part.prim_id, part);
+    paste_rows(inst_id, *this, part.inst_id, part);
+    paste_rows(aa_samples, *this, part.aa_samples, part);
+}
 
 size_t Film::nonfinite_values() const { return count_nonfinite(beauty) + count_nonfinite(normal) + count_nonfinite(albedo); }
 

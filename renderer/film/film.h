@@ -33,6 +33,12 @@ struct PixelWindow {
     bool operator==(const PixelWindow&) const = default;
 };
 
+/// A tile: a rectangle of pixels [x0, x1) x [y0, y1) in full-image coordinates.
+struct TileRect {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    bool operator==(const TileRect&) const = default;
+};
+
 struct Film {
     int full_width = 0, full_height = 0;  ///< the display window
     PixelWindow window;                   ///< rendered region (crop); pixels below are its size
@@ -52,6 +58,10 @@ struct Film {
     int height() const { return window.height(); }
     /// Index of full-image pixel (x, y), which must lie inside the window.
     size_t index(int x, int y) const { return size_t(y - window.y0) * size_t(width()) + size_t(x - window.x0); }
+    /// True when `part`'s window lies inside this film's window, with the same image size and AOVs.
+    bool can_paste(const Film& part) const;
+    /// Copies every buffer of `part` (a tile of the same image, can_paste) into its window here.
+    void paste(const Film& part);
     /// NaN or infinite values in the beauty, normal and albedo buffers (depth is +inf for misses
     /// by design and not counted).
     size_t nonfinite_values() const;

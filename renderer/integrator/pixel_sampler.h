@@ -15,11 +15,6 @@
 
 namespace whitted {
 
-/// A rectangle of pixels [x0, x1) x [y0, y1) in full-image coordinates.
-struct TileRect {
-    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-};
-
 class PixelSampler {
 public:
     /// Samples for `film` (its window) through `camera` and `integrator`, scaled by `exposure`;

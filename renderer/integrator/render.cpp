@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <sstream>
 #include <vector>
 
@@ -127,6 +128,49 @@ Film Renderer::render(const AaSettings& aa, const IntegratorSettings& settings, 
         if (stats) stats->nonfinite_samples += bad;
     }
     return film;
+}
+
+std::vector<TileRect> Renderer::tiles() const { return tile_grid(m_window, m_settings.tile_size); }
+
+void Renderer::render_tiles(const NextTile& next, const TileDone& done, RenderStats* stats) const {
+    const CameraModel camera(m_scene.cameras[size_t(m_settings.camera)], m_size.width, m_size.height);
+    const WhittedIntegrator integrator(m_view, *m_accel, m_settings.integrator);
+    const std::vector<TileRect> tiles = this->tiles();
+    WorkerPool pool(m_settings.threads);
+    std::vector<WorkerRays> rays(size_t(pool.size()));
+    std::mutex handing;  // next() and done(), one at a time
+    uint64_t nonfinite = 0, subdivided = 0, pixels = 0;
+    const auto start = Clock::now();
+    // One iteration per tile at most: each asks `next` for its tile, so they run in its order.
+    pool.for_each(tiles.size(), [&](size_t, int worker) {
+        std::optional<size_t> index;
+        {
+            const std::lock_guard<std::mutex> lock(handing);
+            index = next();
+        }
+        if (!index) return;
+        RT_CHECK(*index < tiles.size());
+        const TileRect& t = tiles[*index];
+        Film film(m_size.width, m_size.height, PixelWindow{t.x0, t.y0, t.x1, t.y1}, m_settings.aovs);
+        PixelSampler sampler(camera, integrator, film, m_settings.aa, m_settings.exposure, 1);
+        for (int pass = 0; pass < sampler.passes(); ++pass) sampler.render_tile(pass, t, 0, rays[size_t(worker)].value);
+        const size_t repaired = film.sanitize_nonfinite();
+        const std::lock_guard<std::mutex> lock(handing);
+        nonfinite += sampler.nonfinite() + repaired;
+        subdivided += sampler.subdivided();
+        pixels += uint64_t(t.x1 - t.x0) * uint64_t(t.y1 - t.y0);
+        done(*index, std::move(film));
+    });
+    if (nonfinite > 0) log_warning("{} samples were not finite and were set to 0", nonfinite);
+    if (stats) {
+        stats->build_seconds = m_build_seconds;
+        stats->render_seconds += std::chrono::duration<double>(Clock::now() - start).count();
+        for (const WorkerRays& r : rays) stats->rays += r.value;
+        stats->nonfinite_samples += nonfinite;
+        stats->pixels += pixels;
+        stats->pixels_subdivided += subdivided;
+        stats->threads = pool.size();
+    }
 }
 
 }  // namespace whitted

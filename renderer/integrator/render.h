@@ -4,9 +4,12 @@
 // function of its image position, and each pixel is reduced from its samples in a fixed order.
 #pragma once
 
+#include <cstddef>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/film/film.h"
@@ -32,6 +35,12 @@ struct RenderStats {
     int threads = 0;                      ///< worker threads used
 };
 
+/// render_tiles(): the next tile to render (an index into Renderer::tiles()), or nothing when no
+/// more should start (all handed out, an interrupt, a distributed job's end).
+using NextTile = std::function<std::optional<size_t>()>;
+/// render_tiles(): one finished tile, its film's window the tile.
+using TileDone = std::function<void(size_t tile, Film&& film)>;
+
 class Renderer {
 public:
     /// Validates the settings against the scene (camera index, crop, sizes) and builds the
@@ -49,6 +58,17 @@ public:
     /// records rays; it must answer for this renderer's scene and view). Benchmarks only.
     Film render(const AaSettings& aa, const IntegratorSettings& integrator, const Accelerator& accel,
                 RenderStats* stats = nullptr) const;
+    /// The window (the image, or the crop) cut into square tiles of RenderSettings::tile_size
+    /// pixels, row-major: the tiles render_tiles() numbers.
+    std::vector<TileRect> tiles() const;
+    /// Renders the tiles `next` hands out, each completely (every pass of its anti-aliasing mode)
+    /// on one worker, as a crop of that tile alone would be: a tile's pixels are bit-identical to
+    /// the same pixels of render(), whatever renders which tile where (threads, processes, hosts).
+    /// Samples that neighbouring tiles share (the corner lattice, adaptive edge points) are traced
+    /// by both. `next` and `done` are called from worker threads, never two at once; a tile whose
+    /// `next` returned starts, and `done` gets it when it is finished. Returns when every started
+    /// tile is done. Counters add into `stats` (stats->pixels counts the tiles rendered here).
+    void render_tiles(const NextTile& next, const TileDone& done, RenderStats* stats = nullptr) const;
     /// The shading kernel render() uses (select_kernel on the scene analysis and the settings).
     KernelFeatures kernel() const { return select_kernel(m_view.analysis().features, m_settings.integrator); }
 
