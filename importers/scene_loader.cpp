@@ -2,6 +2,8 @@
 
 #include "importers/scene_loader.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <filesystem>
 
@@ -12,6 +14,21 @@
 #include "renderer/core/log.h"
 
 namespace whitted {
+
+std::vector<std::pair<std::string, std::string>> describe_import_options(const ImportOptions& o) {
+    auto num = [](const std::optional<float>& v) { return v ? fmt::format("{:.9g}", *v) : std::string("file"); };
+    auto flag = [](bool b) { return std::string(b ? "on" : "off"); };
+    return {{"scene_index", std::to_string(o.scene_index)},
+            {"default_light", flag(o.add_default_light)},
+            {"default_camera", flag(o.add_default_camera)},
+            {"textures", flag(o.load_textures)},
+            {"environment", o.environment.empty() ? "file" : o.environment},
+            {"env_rotate", num(o.environment_rotation)},
+            {"env_exposure", num(o.environment_exposure)},
+            {"no_environment", flag(o.no_environment)},
+            {"default_environment", flag(o.default_environment)},
+            {"env_lights", std::to_string(o.environment_lights)}};
+}
 
 Scene load_scene(const std::string& path, const ImportOptions& options) {
     std::string ext = std::filesystem::path(path).extension().string();

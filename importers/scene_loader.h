@@ -7,6 +7,8 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "renderer/scene/environment.h"
 #include "renderer/scene/scene.h"
@@ -37,6 +39,10 @@ struct ImportOptions {
 /// lights (appended to scene.lights, replacing the default light) and the SH ambient. Throws
 /// whitted::Error for a map that cannot be read.
 void setup_environment(Scene& scene, const ImportOptions& options);
+
+/// Every option the imported scene depends on, by name (as describe_image_settings for the
+/// render settings): what checkpoints and tile-job parts record.
+std::vector<std::pair<std::string, std::string>> describe_import_options(const ImportOptions& options);
 
 /// Loads a scene, dispatching on the extension: .gltf, .glb (import_gltf), .json (the scene file,
 /// import_scene_file in importers/scene_file.h).

@@ -13,7 +13,9 @@
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include <unistd.h>
@@ -26,25 +28,44 @@
 #include "renderer/core/log.h"
 #include "renderer/integrator/render.h"
 #include "renderer/output/image_output.h"
+#include "renderer/session/frame_render.h"
+#include "renderer/session/tile_job.h"
 
 namespace {
 
 using namespace whitted;
 using Clock = std::chrono::steady_clock;
+namespace fs = std::filesystem;
 
-// SIGINT/SIGTERM during `render`: nothing is written before the image is complete, so the first
-// signal ends the process at once, except while the image is being written: that write (atomic,
-// through a temporary file) finishes and the run then exits with 128 + signal. A second SIGINT
-// exits at once in every case, removing the temporary file of an unfinished write.
+// SIGINT/SIGTERM during `render` (docs/distributed.md, "Interruption and resume"): while tiles
+// render, the first signal stops handing out new ones; the tiles in flight finish and the image is
+// written with what is done (missing tiles 0, listed in its metadata) plus a checkpoint for
+// --resume, then the run exits with 128 + signal. Before rendering starts it ends the process at
+// once; during a write, the write (atomic, through a temporary file) finishes first. A second
+// signal exits at once in every case, removing the temporary file of an unfinished write and
+// leaving earlier files as they were.
 std::atomic<int> g_signal_count{0};
 std::atomic<int> g_last_signal{0};
 std::atomic<bool> g_writing{false};
+std::atomic<bool> g_rendering{false};
+std::atomic<bool> g_stop{false};
 
 extern "C" void on_interrupt(int sig) {
     g_last_signal.store(sig);
-    if (g_signal_count.fetch_add(1) == 0 && g_writing.load()) return;
+    const bool first = g_signal_count.fetch_add(1) == 0;
+    if (first && (g_writing.load() || g_rendering.load())) {
+        g_stop.store(true);
+        if (!g_writing.load()) {
+            static const char message[] =
+                "\nwhitted: interrupted: finishing the tiles in flight, then writing what is done "
+                "(interrupt again to quit at once)\n";
+            const ssize_t ignored = ::write(STDERR_FILENO, message, sizeof(message) - 1);
+            (void)ignored;
+        }
+        return;
+    }
     remove_partial_output();
-    static const char message[] = "\nwhitted: interrupted: no image written\n";
+    static const char message[] = "\nwhitted: interrupted: exiting at once; earlier files are left as they were\n";
     const ssize_t ignored = ::write(STDERR_FILENO, message, sizeof(message) - 1);
     (void)ignored;
     ::_exit(128 + sig);
@@ -130,6 +151,10 @@ struct RenderCommand {
     OutputSettings out;                         ///< OCIO config, display and view, bits, EXR half
     std::string precision, bv;                  ///< in-house BVH options appended to the --accel spec
     double max_memory_gb = 8.0;                 ///< ImportOptions::max_memory and the accelerators', in GiB
+    std::string tile_job;                       ///< "i/n": render the i-th of n bands as an EXR part
+    double checkpoint_seconds = 0.0;            ///< > 0: save finished tiles this often
+    bool resume = false;                        ///< continue from the checkpoint
+    std::string checkpoint_file;                ///< empty: beside the output (checkpoint_path_for)
 };
 
 /// The environment flags (docs/environment.md), shared by `render` and `info`.
@@ -145,6 +170,32 @@ void add_environment_options(CLI::App* app, ImportOptions& io) {
                     "Directional lights extracted from the environment's brightest regions (0 = all of its light "
                     "is ambient)")->check(CLI::Range(0, 4096))->capture_default_str();
     app->add_flag("--no-environment", io.no_environment, "No environment, whatever the scene file names");
+}
+
+/// The output flags (colour pipeline, bits, EXR precision), shared by `render` and `merge`.
+void add_output_options(CLI::App* app, OutputSettings& out) {
+    app->add_option("--ocio-config", out.color.config, "OpenColorIO config (default: $OCIO, else the bundled one)");
+    app->add_option("--display", out.color.display, "OCIO display (default: the config's default)");
+    app->add_option("--view", out.color.view, "OCIO view: Standard, ACES 1.0 SDR-video, Raw")->capture_default_str();
+    app->add_option("--bits", out.bits, "Bits per channel for PNG/TIFF: 8 or 16 (0 = format default)")
+        ->check(CLI::IsMember({0, 8, 16}))->capture_default_str();
+    app->add_flag_function("--exr-float", [&out](std::int64_t) { out.exr_half = false; },
+                           "Write EXR beauty as 32-bit float instead of half");
+}
+
+/// `whitted merge`: the parts of a tile job assembled and written like `render` writes a frame.
+int run_merge(const std::vector<std::string>& parts, const std::string& output, OutputSettings os,
+              const std::string& cmdline) {
+    { DisplayTransform check(os.color); }
+    std::map<std::string, std::string> meta;
+    const Film film = merge_parts(parts, &meta);
+    for (const auto& [key, value] : meta) os.metadata[key] = value;
+    os.metadata["whitted:commandLine"] = cmdline;
+    os.metadata["whitted:version"] = WHITTED_VERSION;
+    write_image(film, output, os);
+    std::fprintf(stderr, "whitted: wrote %s (%dx%d) from %zu parts\n", output.c_str(), film.width(), film.height(),
+                 parts.size());
+    return 0;
 }
 
 /// `--precision` and `--bv` are shorthands for the accelerator spec's options of the same names
@@ -180,6 +231,24 @@ int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& 
     // Resolve the color pipeline before the (long) render so bad flags fail fast.
     { DisplayTransform check(os.color); }
 
+    // What the pixels depend on: recorded by checkpoints and tile-job parts, checked by --resume
+    // and `whitted merge`.
+    SettingList identity = {{"version", WHITTED_VERSION}, {"scene", c.input + " (" + file_identity(c.input) + ")"}};
+    for (auto& kv : describe_import_options(c.import)) identity.push_back(kv);
+    for (auto& kv : describe_image_settings(rs)) identity.push_back(kv);
+    if (!c.tile_job.empty()) {
+        const TileJob job = parse_tile_job(c.tile_job);
+        if (fs::path(c.output).extension() != ".exr")
+            throw Error(fmt::format("--tile-job writes an EXR part (merge it with `whitted merge`): got -o {}", c.output));
+        if (rs.camera < 0 || size_t(rs.camera) >= scene.cameras.size())
+            throw Error(fmt::format("--camera {}: the scene has {} camera(s)", rs.camera, scene.cameras.size()));
+        const ImageSize full = resolve_image_size(scene.cameras[size_t(rs.camera)], rs.width, rs.height);
+        const PixelWindow frame = rs.crop.value_or(PixelWindow{0, 0, full.width, full.height});
+        rs.crop = tile_job_window(frame, job);
+        for (const auto& [key, value] : tile_job_metadata(job, frame, identity)) os.metadata[key] = value;
+        os.exr_half = false;  // exact: the merged frame is bit-identical to a one-piece render
+    }
+
     Renderer renderer(scene, rs);
     const ImageSize size = renderer.image_size();
     log_info("{}: {} triangles in {} instances, {} lights, camera {}/{}{}, {}x{}", c.input,
@@ -199,8 +268,27 @@ int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& 
         }
         log_info("kernel: {}", kernel_name(renderer.kernel()));
     }
-    RenderStats stats;
-    Film film = renderer.render(&stats);
+    FrameOptions fo;
+    fo.identity = identity;
+    fo.identity.emplace_back("window", fmt::format("{},{},{},{}", renderer.window().x0, renderer.window().y0,
+                                                   renderer.window().x1, renderer.window().y1));
+    fo.checkpoint_path = c.checkpoint_file.empty() ? checkpoint_path_for(c.output) : c.checkpoint_file;
+    fo.checkpoint_seconds = c.checkpoint_seconds;
+    fo.resume = c.resume;
+    fo.stop = &g_stop;
+    fo.progress = rs.progress;
+    g_rendering.store(true);
+    FrameResult frame = render_frame(renderer, fo);
+    g_rendering.store(false);
+    const RenderStats& stats = frame.stats;
+    const Film& film = frame.film;
+    const std::vector<size_t> missing = frame.missing();
+    if (!missing.empty()) {
+        os.metadata["whitted:missingTiles"] = describe_tiles(frame.tiles, missing);
+        os.metadata["whitted:incomplete"] =
+            fmt::format("{} of {} tiles missing (0 in the image); continue with --resume", missing.size(),
+                        frame.tiles.size());
+    }
     const char* aa_name = aa_mode_name(rs.aa.mode);
 
     const auto t_write = Clock::now();
@@ -221,6 +309,17 @@ int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& 
     g_writing.store(true);
     write_image(film, c.output, os);
     g_writing.store(false);
+    if (!missing.empty()) {
+        std::fprintf(stderr,
+                     "whitted: interrupted: wrote %s with %zu of %zu tiles (the missing ones are 0 and listed in its "
+                     "metadata) and the checkpoint %s; continue with --resume\n",
+                     c.output.c_str(), frame.tiles.size() - missing.size(), frame.tiles.size(),
+                     fo.checkpoint_path.c_str());
+        return 128 + g_last_signal.load();
+    }
+    // The finished frame is written: its checkpoint is no longer needed.
+    std::error_code ec;
+    fs::remove(fo.checkpoint_path, ec);
     if (g_signal_count.load() > 0) {
         std::fprintf(stderr, "whitted: interrupted: wrote %s before exiting\n", c.output.c_str());
         return 128 + g_last_signal.load();
@@ -354,21 +453,24 @@ int main(int argc, char** argv) {
     render->add_flag("--robust,!--no-robust", rs.robust,
                      "Embree robust mode (RTC_SCENE_FLAG_ROBUST, the default): no light leaks at shared edges; "
                      "--no-robust is 3-8% faster and leaks a few % of rays aimed at edges and vertices");
-    render->add_option("--ocio-config", rc.out.color.config,
-                       "OpenColorIO config (default: $OCIO, else the bundled one)");
-    render->add_option("--display", rc.out.color.display, "OCIO display (default: the config's default)");
-    render->add_option("--view", rc.out.color.view, "OCIO view: Standard, ACES 1.0 SDR-video, Raw")
-        ->capture_default_str();
-    render->add_option("--bits", rc.out.bits, "Bits per channel for PNG/TIFF: 8 or 16 (0 = format default)")
-        ->check(CLI::IsMember({0, 8, 16}))->capture_default_str();
-    render->add_flag_function("--exr-float", [&](std::int64_t) { rc.out.exr_half = false; },
-                              "Write EXR beauty as 32-bit float instead of half");
+    add_output_options(render, rc.out);
     render->add_flag_function("--no-progress", [&](std::int64_t) { rs.progress = false; }, "Do not draw the progress bar");
     render->add_option("--max-memory", rc.max_memory_gb, "Refuse scenes whose data would exceed this many GiB")
         ->check(CLI::PositiveNumber)->capture_default_str();
     render->add_flag("--allow-outside-uris", rc.import.allow_outside_uris,
                      "Let the file's external URIs leave its folder (../); absolute and file:// URIs stay refused");
     add_environment_options(render, rc.import);
+    render->add_option("--tile-job", rc.tile_job,
+                       "Render only part i of n (i/n, 1 <= i <= n: horizontal bands) as an EXR part for `whitted "
+                       "merge` (docs/distributed.md)");
+    render->add_option("--checkpoint", rc.checkpoint_seconds,
+                       "Save the finished tiles to the checkpoint at least every this many seconds (an interrupted "
+                       "render always saves them)")->check(CLI::PositiveNumber);
+    render->add_flag("--resume", rc.resume,
+                     "Continue from the checkpoint: render only the tiles it lacks (refused when it was made with "
+                     "other settings)");
+    render->add_option("--checkpoint-file", rc.checkpoint_file,
+                       "Checkpoint path (default: the output path + .checkpoint.exr)");
 
     // whitted info
     std::string info_input;
@@ -382,6 +484,16 @@ int main(int argc, char** argv) {
     info->add_flag("--allow-outside-uris", info_import.allow_outside_uris,
                    "Let the file's external URIs leave its folder (../); absolute and file:// URIs stay refused");
     add_environment_options(info, info_import);
+
+    // whitted merge
+    std::vector<std::string> merge_parts_in;
+    std::string merge_output;
+    OutputSettings merge_out;
+    CLI::App* merge = app.add_subcommand("merge", "Assemble the EXR parts of `render --tile-job i/n` into the frame");
+    merge->add_option("parts", merge_parts_in, "The parts (EXR files written with --tile-job), in any order")->required();
+    merge->add_option("-o,--output", merge_output,
+                      "Output image; the extension picks the format, as for `render`")->required();
+    add_output_options(merge, merge_out);
 
     // whitted bench <name>: benchmarks print figures and write CSV/plots (docs/performance.md).
     CLI::App* bench = app.add_subcommand("bench", "Benchmarks: print figures, write CSV and plots");
@@ -397,6 +509,7 @@ int main(int argc, char** argv) {
     // Global options (--log-level) may also follow the subcommand.
     render->fallthrough();
     info->fallthrough();
+    merge->fallthrough();
     bench->fallthrough();
     for (app::Command& c : commands) c.app->fallthrough();
 
@@ -430,6 +543,7 @@ int main(int argc, char** argv) {
             return run_render(rc, command_line(argc, argv), flag_given);
         }
         if (info->parsed()) return run_info(info_input, info_import);
+        if (merge->parsed()) return run_merge(merge_parts_in, merge_output, merge_out, command_line(argc, argv));
         for (app::Command& c : commands)
             if (c.app->parsed()) return c.run();
     } catch (const Error& e) {

@@ -73,6 +73,9 @@ public:
     KernelFeatures kernel() const { return select_kernel(m_view.analysis().features, m_settings.integrator); }
 
     ImageSize image_size() const { return m_size; }
+    /// The rendered region: the whole image, or the crop.
+    PixelWindow window() const { return m_window; }
+    const RenderSettings& settings() const { return m_settings; }
     const Accelerator& accelerator() const { return *m_accel; }
     const SceneView& view() const { return m_view; }
     double build_seconds() const { return m_build_seconds; }

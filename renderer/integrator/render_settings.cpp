@@ -1,5 +1,7 @@
 #include "renderer/integrator/render_settings.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -47,6 +49,43 @@ void apply_scene_settings(const SceneRenderSettings& s, RenderSettings& rs, cons
     // miss see it unless the caller set a background.
     if (s.ambient || !from_file("ambient")) rs.integrator.environment_ambient = false;
     if (!from_file("background")) rs.integrator.environment_visible = false;
+}
+
+SettingList describe_image_settings(const RenderSettings& rs) {
+    auto num = [](double v) { return fmt::format("{:.9g}", v); };
+    auto color = [&](const Color& c) { return fmt::format("{},{},{}", num(c.x), num(c.y), num(c.z)); };
+    auto flag = [](bool b) { return std::string(b ? "on" : "off"); };
+    const IntegratorSettings& in = rs.integrator;
+    const AovSet& a = rs.aovs;
+    SettingList out = {
+        {"width", std::to_string(rs.width)},
+        {"height", std::to_string(rs.height)},
+        {"camera", std::to_string(rs.camera)},
+        {"max_depth", std::to_string(in.max_depth)},
+        {"background", color(in.background)},
+        {"ambient", color(in.ambient)},
+        {"fresnel", flag(in.fresnel)},
+        {"min_weight", num(in.min_weight)},
+        {"specialize", flag(in.specialize)},
+        {"environment_ambient", flag(in.environment_ambient)},
+        {"environment_visible", flag(in.environment_visible)},
+        {"mirror_cutoff", num(rs.mapping.mirror_roughness_cutoff)},
+        {"max_exponent", num(rs.mapping.max_exponent)},
+        {"refract_thin", flag(rs.mapping.refract_thin)},
+        {"exposure", num(rs.exposure)},
+        {"tile_size", std::to_string(rs.tile_size)},
+        {"crop", rs.crop ? fmt::format("{},{},{},{}", rs.crop->x0, rs.crop->y0, rs.crop->x1, rs.crop->y1) : "none"},
+        {"aovs", fmt::format("depth={} normal={} albedo={} prim_id={} inst_id={} aa_samples={}", flag(a.depth),
+                             flag(a.normal), flag(a.albedo), flag(a.prim_id), flag(a.inst_id), flag(a.aa_samples))},
+        {"aa", aa_mode_name(rs.aa.mode)},
+        {"aa_threshold", num(rs.aa.threshold)},
+        {"aa_depth", std::to_string(rs.aa.depth)},
+        {"spp", std::to_string(rs.aa.spp)},
+        {"filter", pixel_filter_name(rs.aa.filter)},
+        {"accel", rs.accel},
+        {"robust", flag(rs.robust)},
+    };
+    return out;
 }
 
 }  // namespace whitted

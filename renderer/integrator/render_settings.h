@@ -4,6 +4,8 @@
 
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "renderer/film/film.h"
 #include "renderer/integrator/aa_sampler.h"
@@ -37,5 +39,13 @@ struct RenderSettings {
 /// the other becomes 0 (the camera's aspect completes it). Output path, OCIO view and display
 /// belong to the output stage (apply_scene_output_settings).
 void apply_scene_settings(const SceneRenderSettings& s, RenderSettings& rs, const SettingGiven& given = {});
+
+/// A setting's name and its value as text, exact (floats to 9 significant digits).
+using SettingList = std::vector<std::pair<std::string, std::string>>;
+
+/// Every setting of `rs` the rendered pixels depend on (not threads or the progress bar), by
+/// name: what a checkpoint and the parts of a tile job record, so that a resume or a merge can
+/// refuse pieces made otherwise and say which setting differs.
+SettingList describe_image_settings(const RenderSettings& rs);
 
 }  // namespace whitted

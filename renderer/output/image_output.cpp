@@ -501,4 +501,65 @@ std::vector<float> read_image_rgb(const std::string& path, int& width, int& heig
     return rgb;
 }
 
+Film read_film(const std::string& path, std::map<std::string, std::string>* metadata) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw Error(fmt::format("{}: cannot read: {}", path, OIIO::geterror()));
+    const OIIO::ImageSpec& spec = in->spec();
+    if (std::string_view(in->format_name()) != "openexr") throw Error(fmt::format("{}: not an EXR file", path));
+    auto channel = [&](std::string_view name) {
+        for (int c = 0; c < spec.nchannels; ++c)
+            if (spec.channelnames[size_t(c)] == name) return c;
+        return -1;
+    };
+    const int r = channel("R"), g = channel("G"), b = channel("B");
+    if (r < 0 || g < 0 || b < 0) throw Error(fmt::format("{}: no R, G, B channels", path));
+    AovSet aovs;
+    aovs.depth = channel("Z") >= 0;
+    aovs.normal = channel("N.X") >= 0;
+    aovs.albedo = channel("albedo.R") >= 0;
+    aovs.prim_id = channel("primId") >= 0;
+    aovs.inst_id = channel("instId") >= 0;
+    aovs.aa_samples = channel("aa.samples") >= 0;
+    const PixelWindow window{spec.x, spec.y, spec.x + spec.width, spec.y + spec.height};
+    if (spec.full_x != 0 || spec.full_y != 0 || window.x0 < 0 || window.y0 < 0 || window.x1 > spec.full_width ||
+        window.y1 > spec.full_height || spec.width <= 0 || spec.height <= 0)
+        throw Error(fmt::format("{}: data window {},{},{},{} is not inside the {}x{} display window", path, window.x0,
+                                window.y0, window.x1, window.y1, spec.full_width, spec.full_height));
+    Film film(spec.full_width, spec.full_height, window, aovs);
+    const size_t n = film.beauty.size();
+    // Channel by channel as float; the ids as 32-bit unsigned, exactly.
+    auto read_channel = [&](int c, OIIO::TypeDesc type, void* out) {
+        if (!in->read_image(0, 0, c, c + 1, type, out))
+            throw Error(fmt::format("{}: {}", path, in->geterror()));
+    };
+    std::vector<float> plane(n);
+    auto read_into = [&](int c, auto&& store) {
+        read_channel(c, OIIO::TypeFloat, plane.data());
+        for (size_t i = 0; i < n; ++i) store(i, plane[i]);
+    };
+    read_into(r, [&](size_t i, float v) { film.beauty[i].x = v; });
+    read_into(g, [&](size_t i, float v) { film.beauty[i].y = v; });
+    read_into(b, [&](size_t i, float v) { film.beauty[i].z = v; });
+    if (aovs.depth) read_into(channel("Z"), [&](size_t i, float v) { film.depth[i] = v; });
+    if (aovs.normal) {
+        read_into(channel("N.X"), [&](size_t i, float v) { film.normal[i].x = v; });
+        read_into(channel("N.Y"), [&](size_t i, float v) { film.normal[i].y = v; });
+        read_into(channel("N.Z"), [&](size_t i, float v) { film.normal[i].z = v; });
+    }
+    if (aovs.albedo) {
+        read_into(channel("albedo.R"), [&](size_t i, float v) { film.albedo[i].x = v; });
+        read_into(channel("albedo.G"), [&](size_t i, float v) { film.albedo[i].y = v; });
+        read_into(channel("albedo.B"), [&](size_t i, float v) { film.albedo[i].z = v; });
+    }
+    if (aovs.prim_id) read_channel(channel("primId"), OIIO::TypeUInt, film.prim_id.data());
+    if (aovs.inst_id) read_channel(channel("instId"), OIIO::TypeUInt, film.inst_id.data());
+    if (aovs.aa_samples) read_into(channel("aa.samples"), [&](size_t i, float v) { film.aa_samples[i] = v; });
+    if (metadata) {
+        metadata->clear();
+        for (const OIIO::ParamValue& p : spec.extra_attribs)
+            if (p.type() == OIIO::TypeString) (*metadata)[p.name().string()] = p.get_string();
+    }
+    return film;
+}
+
 }  // namespace whitted

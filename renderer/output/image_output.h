@@ -65,6 +65,11 @@ void write_image(const Film& film, const std::string& path, const OutputSettings
 /// handlers, so an interrupted write leaves nothing behind).
 void remove_partial_output() noexcept;
 
+/// An EXR that write_image wrote (beauty and AOV channels by name, data and display windows)
+/// read back into a Film, with its string metadata. Throws whitted::Error naming the file when it
+/// cannot be read, is not an EXR or lacks the R, G, B channels. Exact for float EXRs.
+Film read_film(const std::string& path, std::map<std::string, std::string>* metadata = nullptr);
+
 /// Reads an image into linear float RGB (EXR as stored; 8/16-bit files decoded by OIIO as
 /// stored, no color conversion). For tests and comparisons.
 std::vector<float> read_image_rgb(const std::string& path, int& width, int& height);

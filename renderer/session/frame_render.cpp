@@ -1,0 +1,157 @@
+#include "renderer/session/frame_render.h"
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "renderer/core/error.h"
+#include "renderer/core/log.h"
+#include "renderer/core/progress.h"
+#include "renderer/output/image_output.h"
+
+namespace whitted {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+constexpr const char* kCheckpointKey = "whitted:checkpoint";
+constexpr const char* kTilesKey = "whitted:checkpointTiles";
+constexpr const char* kSettingPrefix = "whitted:setting:";
+
+/// The done flags as a string of '0' and '1' (one per tile, readable in `oiiotool --info -v`).
+std::string encode_done(const std::vector<uint8_t>& done) {
+    std::string s(done.size(), '0');
+    for (size_t i = 0; i < done.size(); ++i) s[i] = done[i] ? '1' : '0';
+    return s;
+}
+
+void write_checkpoint(const std::string& path, const FrameResult& frame, const SettingList& identity) {
+    OutputSettings os;
+    os.exr_half = false;  // exact: the resumed frame must be bit-identical
+    os.metadata[kCheckpointKey] = "1";
+    os.metadata[kTilesKey] = encode_done(frame.done);
+    for (const auto& [key, value] : identity) os.metadata[kSettingPrefix + key] = value;
+    write_image(frame.film, path, os);
+}
+
+/// Takes a checkpoint's finished tiles into `frame` after checking that it belongs to this render.
+void resume_from(const std::string& path, const SettingList& identity, FrameResult& frame) {
+    if (!fs::exists(path)) throw Error(fmt::format("--resume: no checkpoint {}", path));
+    std::map<std::string, std::string> meta;
+    const Film saved = read_film(path, &meta);
+    if (!meta.count(kCheckpointKey)) throw Error(fmt::format("{}: not a whitted checkpoint", path));
+    for (const auto& [key, value] : identity) {
+        const auto it = meta.find(kSettingPrefix + key);
+        const std::string was = it == meta.end() ? "(not recorded)" : it->second;
+        if (was != value)
+            throw Error(fmt::format("{}: made with {} = {}, this render has {} = {} (render without --resume to "
+                                    "start again)",
+                                    path, key, was, key, value));
+    }
+    const auto tiles = meta.find(kTilesKey);
+    if (tiles == meta.end() || tiles->second.size() != frame.tiles.size() || !(saved.window == frame.film.window) ||
+        !frame.film.can_paste(saved))
+        throw Error(fmt::format("{}: its tiles do not match this render's {} tiles of window {},{},{},{}", path,
+                                frame.tiles.size(), frame.film.window.x0, frame.film.window.y0, frame.film.window.x1,
+                                frame.film.window.y1));
+    frame.film = saved;
+    for (size_t i = 0; i < frame.tiles.size(); ++i) {
+        const char c = tiles->second[i];
+        if (c != '0' && c != '1') throw Error(fmt::format("{}: broken tile list", path));
+        frame.done[i] = c == '1';
+        frame.resumed += frame.done[i];
+    }
+    // The unfinished tiles start from the empty film's values, as in a fresh render.
+    const Film empty(saved.full_width, saved.full_height, saved.window, saved.aovs);
+    for (size_t i = 0; i < frame.tiles.size(); ++i) {
+        if (frame.done[i]) continue;
+        const TileRect& t = frame.tiles[i];
+        Film blank(empty.full_width, empty.full_height, PixelWindow{t.x0, t.y0, t.x1, t.y1}, empty.aovs);
+        frame.film.paste(blank);
+    }
+}
+
+}  // namespace
+
+std::vector<size_t> FrameResult::missing() const {
+    std::vector<size_t> out;
+    for (size_t i = 0; i < done.size(); ++i)
+        if (!done[i]) out.push_back(i);
+    return out;
+}
+
+std::string describe_tiles(const std::vector<TileRect>& tiles, const std::vector<size_t>& which) {
+    std::string s;
+    for (const size_t i : which) {
+        const TileRect& t = tiles[i];
+        s += fmt::format("{}{},{},{},{}", s.empty() ? "" : " ", t.x0, t.y0, t.x1, t.y1);
+    }
+    return s;
+}
+
+std::string checkpoint_path_for(const std::string& output) { return output + ".checkpoint.exr"; }
+
+std::string file_identity(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(fmt::format("{}: cannot read", path));
+    uint64_t hash = 0xcbf29ce484222325ull, size = 0;
+    char buffer[1 << 16];
+    while (in) {
+        in.read(buffer, sizeof(buffer));
+        const std::streamsize n = in.gcount();
+        for (std::streamsize i = 0; i < n; ++i) hash = (hash ^ uint8_t(buffer[i])) * 0x100000001b3ull;
+        size += uint64_t(n);
+    }
+    return fmt::format("{} bytes, fnv1a64 {:016x}", size, hash);
+}
+
+FrameResult render_frame(const Renderer& renderer, const FrameOptions& options) {
+    FrameResult frame;
+    frame.tiles = renderer.tiles();
+    frame.done.assign(frame.tiles.size(), 0);
+    const ImageSize size = renderer.image_size();
+    frame.film = Film(size.width, size.height, renderer.window(), renderer.settings().aovs);
+    if (options.resume) {
+        resume_from(options.checkpoint_path, options.identity, frame);
+        log_info("resumed {} of {} tiles from {}", frame.resumed, frame.tiles.size(), options.checkpoint_path);
+    }
+
+    ProgressBar progress(frame.tiles.size() - frame.resumed, options.progress);
+    size_t cursor = 0;
+    auto last_save = Clock::now();
+    auto next = [&]() -> std::optional<size_t> {
+        if (options.stop && options.stop->load()) return std::nullopt;
+        while (cursor < frame.tiles.size() && frame.done[cursor]) ++cursor;
+        if (cursor == frame.tiles.size()) return std::nullopt;
+        return cursor++;
+    };
+    auto done = [&](size_t tile, Film&& film) {
+        frame.film.paste(film);
+        frame.done[tile] = 1;
+        progress.advance();
+        if (options.checkpoint_seconds > 0 && !options.checkpoint_path.empty() &&
+            std::chrono::duration<double>(Clock::now() - last_save).count() >= options.checkpoint_seconds) {
+            write_checkpoint(options.checkpoint_path, frame, options.identity);
+            frame.checkpoint_written = true;
+            last_save = Clock::now();
+        }
+    };
+    renderer.render_tiles(next, done, &frame.stats);
+    progress.finish();
+
+    const std::vector<size_t> missing = frame.missing();
+    if (!missing.empty() && !options.checkpoint_path.empty()) {
+        write_checkpoint(options.checkpoint_path, frame, options.identity);
+        frame.checkpoint_written = true;
+    }
+    return frame;
+}
+
+}  // namespace whitted

@@ -1,0 +1,58 @@
+// A frame rendered tile by tile so that it can stop early and go on later: an interrupt stops
+// handing out tiles and keeps the finished ones, a checkpoint file holds them (periodically and
+// at the interrupt), and a resumed render takes them back and renders only the rest. The tiles
+// are Renderer::render_tiles', so the finished frame is bit-identical to an uninterrupted one.
+// docs/distributed.md.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "renderer/film/film.h"
+#include "renderer/integrator/render.h"
+#include "renderer/integrator/render_settings.h"
+
+namespace whitted {
+
+struct FrameOptions {
+    SettingList identity;                     ///< what the pixels depend on (settings, scene, version); a
+                                              ///< checkpoint records it and a resume must match it
+    std::string checkpoint_path;              ///< empty: never write a checkpoint
+    double checkpoint_seconds = 0.0;          ///< > 0: save the finished tiles at least this often
+    bool resume = false;                      ///< start from checkpoint_path's finished tiles
+    const std::atomic<bool>* stop = nullptr;  ///< once true, no new tile starts (set by a signal handler)
+    bool progress = false;                    ///< progress bar over the tiles on stderr
+};
+
+struct FrameResult {
+    Film film;                   ///< the window; unfinished tiles are 0 (ids: none)
+    RenderStats stats;           ///< of the tiles rendered now
+    std::vector<TileRect> tiles; ///< Renderer::tiles()
+    std::vector<uint8_t> done;   ///< per tile: finished (now or from the checkpoint)
+    size_t resumed = 0;          ///< tiles taken from the checkpoint
+    bool checkpoint_written = false;  ///< the checkpoint now holds this frame's finished tiles
+    /// Indices of the unfinished tiles (empty when the frame is complete).
+    std::vector<size_t> missing() const;
+};
+
+/// Renders the frame's tiles in order, skipping those a resumed checkpoint holds. With
+/// options.stop set it returns early (tiles in flight finish first); when tiles are then missing
+/// and a checkpoint path is set, the checkpoint is written (the caller removes it once the finished
+/// frame is safely written). Throws whitted::Error naming the checkpoint when a resume finds none, a broken one,
+/// or one made otherwise (the first setting that differs).
+FrameResult render_frame(const Renderer& renderer, const FrameOptions& options);
+
+/// The tiles `which` as text, "x0,y0,x1,y1" each, space-separated (the metadata of a partial image).
+std::string describe_tiles(const std::vector<TileRect>& tiles, const std::vector<size_t>& which);
+
+/// Default checkpoint path beside an output image: "<output>.checkpoint.exr".
+std::string checkpoint_path_for(const std::string& output);
+
+/// A file's identity for FrameOptions::identity: its size and a 64-bit FNV-1a hash of its bytes.
+/// Throws whitted::Error naming the file when it cannot be read.
+std::string file_identity(const std::string& path);
+
+}  // namespace whitted
