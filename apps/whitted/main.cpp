@@ -16,6 +16,8 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <memory>
+#include <optional>
 #include <sstream>
 
 #include <unistd.h>
@@ -29,6 +31,7 @@
 #include "renderer/integrator/render.h"
 #include "renderer/output/image_output.h"
 #include "renderer/session/frame_render.h"
+#include "renderer/session/mpi_frame.h"
 #include "renderer/session/tile_job.h"
 
 namespace {
@@ -49,6 +52,10 @@ std::atomic<int> g_last_signal{0};
 std::atomic<bool> g_writing{false};
 std::atomic<bool> g_rendering{false};
 std::atomic<bool> g_stop{false};
+// Under MPI, once the ranks render together an error on one rank ends them all (MPI_Abort):
+// the others would wait for it forever.
+std::atomic<bool> g_mpi_running{false};
+const whitted::MpiSession* g_mpi = nullptr;
 
 extern "C" void on_interrupt(int sig) {
     g_last_signal.store(sig);
@@ -121,7 +128,10 @@ AovSet parse_aovs(const std::vector<std::string>& names) {
 
 std::string command_line(int argc, char** argv) {
     std::string s;
-    for (int i = 0; i < argc; ++i) s += (i ? " " : "") + std::string(argv[i]);
+    for (int i = 0; i < argc; ++i) {
+        if (i) s += ' ';
+        s += argv[i];
+    }
     return s;
 }
 
@@ -210,46 +220,77 @@ std::string with_spec_options(std::string spec, std::initializer_list<std::pair<
     return spec;
 }
 
-int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& given) {
-    install_interrupt_handlers();
-    const auto t_load = Clock::now();
-    c.import.max_memory = size_t(c.max_memory_gb * double(size_t(1) << 30));
-    set_accelerator_memory_limit(c.import.max_memory);
-    Scene scene = load_scene(c.input, c.import);
-    const double load_s = seconds_since(t_load);
-    for (const std::string& w : scene.warnings) log_warning("{}: {}", c.input, w);
+/// Under MPI the ranks agree on the set-up: when any failed, every rank returns false; the
+/// error is printed once (rank 0's, or else each failed rank's, prefixed with its number).
+bool setup_agreed(const MpiSession& mpi, const std::string& error) {
+    if (mpi.all(error.empty())) return true;
+    const bool root_failed = mpi.from_root(mpi.rank() == 0 && !error.empty());
+    if (!error.empty() && (mpi.rank() == 0 || !root_failed)) {
+        if (mpi.rank() == 0) std::fprintf(stderr, "whitted: error: %s\n", error.c_str());
+        else std::fprintf(stderr, "whitted: error: rank %d: %s\n", mpi.rank(), error.c_str());
+    }
+    if (mpi.rank() == 0 && !root_failed) std::fprintf(stderr, "whitted: error: set-up failed on other ranks\n");
+    return false;
+}
 
+int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& given, const MpiSession* mpi) {
+    const bool root = !mpi || mpi->rank() == 0;
+    if (root) install_interrupt_handlers();
     // The scene file's settings fill what the flags did not set.
     RenderSettings& rs = c.render;
     OutputSettings& os = c.out;
-    apply_scene_settings(scene.settings, rs, given);
-    apply_scene_output_settings(scene.settings, c.input, c.output, os, given);
-    if (!(rs.integrator.min_weight >= 0.f && rs.integrator.min_weight <= 1.f))
-        throw Error(fmt::format("min_weight {} is out of range (expected 0 to 1)", rs.integrator.min_weight));
-    rs.accel = with_spec_options(rs.accel, {{"precision", c.precision}, {"bv", c.bv}});
+    Scene scene;
+    double load_s = 0.0;
+    SettingList identity;
+    std::unique_ptr<Renderer> renderer_ptr;
+    std::string setup_error;
+    try {
+        const auto t_load = Clock::now();
+        c.import.max_memory = size_t(c.max_memory_gb * double(size_t(1) << 30));
+        set_accelerator_memory_limit(c.import.max_memory);
+        scene = load_scene(c.input, c.import);
+        load_s = seconds_since(t_load);
+        for (const std::string& w : scene.warnings) log_warning("{}: {}", c.input, w);
 
-    // Resolve the color pipeline before the (long) render so bad flags fail fast.
-    { DisplayTransform check(os.color); }
+        // The scene file's settings fill what the flags did not set.
+        apply_scene_settings(scene.settings, rs, given);
+        apply_scene_output_settings(scene.settings, c.input, c.output, os, given);
+        if (!(rs.integrator.min_weight >= 0.f && rs.integrator.min_weight <= 1.f))
+            throw Error(fmt::format("min_weight {} is out of range (expected 0 to 1)", rs.integrator.min_weight));
+        rs.accel = with_spec_options(rs.accel, {{"precision", c.precision}, {"bv", c.bv}});
 
-    // What the pixels depend on: recorded by checkpoints and tile-job parts, checked by --resume
-    // and `whitted merge`.
-    SettingList identity = {{"version", WHITTED_VERSION}, {"scene", c.input + " (" + file_identity(c.input) + ")"}};
-    for (auto& kv : describe_import_options(c.import)) identity.push_back(kv);
-    for (auto& kv : describe_image_settings(rs)) identity.push_back(kv);
-    if (!c.tile_job.empty()) {
-        const TileJob job = parse_tile_job(c.tile_job);
-        if (fs::path(c.output).extension() != ".exr")
-            throw Error(fmt::format("--tile-job writes an EXR part (merge it with `whitted merge`): got -o {}", c.output));
-        if (rs.camera < 0 || size_t(rs.camera) >= scene.cameras.size())
-            throw Error(fmt::format("--camera {}: the scene has {} camera(s)", rs.camera, scene.cameras.size()));
-        const ImageSize full = resolve_image_size(scene.cameras[size_t(rs.camera)], rs.width, rs.height);
-        const PixelWindow frame = rs.crop.value_or(PixelWindow{0, 0, full.width, full.height});
-        rs.crop = tile_job_window(frame, job);
-        for (const auto& [key, value] : tile_job_metadata(job, frame, identity)) os.metadata[key] = value;
-        os.exr_half = false;  // exact: the merged frame is bit-identical to a one-piece render
+        // Resolve the color pipeline before the (long) render so bad flags fail fast.
+        { DisplayTransform check(os.color); }
+
+        // What the pixels depend on: recorded by checkpoints and tile-job parts, checked by --resume
+        // and `whitted merge`.
+        identity = {{"version", WHITTED_VERSION}, {"scene", c.input + " (" + file_identity(c.input) + ")"}};
+        for (auto& kv : describe_import_options(c.import)) identity.push_back(kv);
+        for (auto& kv : describe_image_settings(rs)) identity.push_back(kv);
+        if (!c.tile_job.empty()) {
+            const TileJob job = parse_tile_job(c.tile_job);
+            if (fs::path(c.output).extension() != ".exr")
+                throw Error(fmt::format("--tile-job writes an EXR part (merge it with `whitted merge`): got -o {}", c.output));
+            if (rs.camera < 0 || size_t(rs.camera) >= scene.cameras.size())
+                throw Error(fmt::format("--camera {}: the scene has {} camera(s)", rs.camera, scene.cameras.size()));
+            const ImageSize full = resolve_image_size(scene.cameras[size_t(rs.camera)], rs.width, rs.height);
+            const PixelWindow frame = rs.crop.value_or(PixelWindow{0, 0, full.width, full.height});
+            rs.crop = tile_job_window(frame, job);
+            for (const auto& [key, value] : tile_job_metadata(job, frame, identity)) os.metadata[key] = value;
+            os.exr_half = false;  // exact: the merged frame is bit-identical to a one-piece render
+        }
+        renderer_ptr = std::make_unique<Renderer>(scene, rs);
+    } catch (const Error& e) {
+        if (!mpi || mpi->size() == 1) throw;
+        setup_error = e.what();
     }
-
-    Renderer renderer(scene, rs);
+    if (mpi && mpi->size() > 1 && !setup_agreed(*mpi, setup_error)) return 1;
+    const Renderer& renderer = *renderer_ptr;
+    if (mpi && mpi->size() > 1 && !root) {  // a worker rank: tiles for rank 0, nothing else
+        g_mpi_running.store(true);
+        serve_mpi_worker(*mpi, renderer);
+        return 0;
+    }
     const ImageSize size = renderer.image_size();
     log_info("{}: {} triangles in {} instances, {} lights, camera {}/{}{}, {}x{}", c.input,
              scene.instanced_triangle_count(), scene.instances.size(), scene.lights.size(), rs.camera,
@@ -278,7 +319,14 @@ int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& 
     fo.stop = &g_stop;
     fo.progress = rs.progress;
     g_rendering.store(true);
-    FrameResult frame = render_frame(renderer, fo);
+    std::optional<MpiTileServer> server;
+    if (mpi && mpi->size() > 1) {
+        server.emplace(*mpi, renderer);
+        g_mpi_running.store(true);
+        log_info("MPI: {} ranks, {} threads each", mpi->size(), renderer.settings().threads);
+    }
+    FrameResult frame = render_frame(renderer, fo, server ? &*server : nullptr);
+    g_mpi_running.store(false);
     g_rendering.store(false);
     const RenderStats& stats = frame.stats;
     const Film& film = frame.film;
@@ -357,6 +405,13 @@ int run_info(const std::string& input, const ImportOptions& io) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    // Under an MPI launcher (mpirun -n N whitted render ...): MPI for the process's life; a plain
+    // run never initialises it (docs/distributed.md).
+    std::optional<MpiSession> mpi;
+    if (launched_by_mpi() && mpi_available()) {
+        mpi.emplace(&argc, &argv);
+        g_mpi = &*mpi;
+    }
     CLI::App app{"whitted: a Whitted-style (1980) recursive ray tracer for glTF 2.0 scenes"};
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string("whitted ") + WHITTED_VERSION);
@@ -533,6 +588,8 @@ int main(int argc, char** argv) {
 
     try {
         set_log_level(parse_log_level(log_level));
+        // Under MPI only rank 0 reports; the others print errors only (each rank loads the same scene).
+        if (g_mpi && g_mpi->rank() > 0) set_log_level(std::max(parse_log_level(log_level), LogLevel::Error));
         if (render->parsed()) {
             // A setting's scene-file key names its flag: aa_threshold -> --aa-threshold.
             const SettingGiven flag_given = [&](std::string_view key) {
@@ -540,13 +597,17 @@ int main(int argc, char** argv) {
                 std::replace(flag.begin(), flag.end(), '_', '-');
                 return render->count(flag) > 0;
             };
-            return run_render(rc, command_line(argc, argv), flag_given);
+            return run_render(rc, command_line(argc, argv), flag_given, g_mpi);
         }
         if (info->parsed()) return run_info(info_input, info_import);
         if (merge->parsed()) return run_merge(merge_parts_in, merge_output, merge_out, command_line(argc, argv));
         for (app::Command& c : commands)
             if (c.app->parsed()) return c.run();
     } catch (const Error& e) {
+        if (g_mpi && g_mpi_running.load()) {
+            std::fprintf(stderr, "whitted: error: rank %d: %s\n", g_mpi->rank(), e.what());
+            g_mpi->abort(1);
+        }
         std::fprintf(stderr, "whitted: error: %s\n", e.what());
         return 1;
     } catch (const std::bad_alloc&) {

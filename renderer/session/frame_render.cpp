@@ -1,11 +1,13 @@
 #include "renderer/session/frame_render.h"
 
 #include <chrono>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <mutex>
 #include <optional>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -35,9 +37,13 @@ std::string encode_done(const std::vector<uint8_t>& done) {
 void write_checkpoint(const std::string& path, const FrameResult& frame, const SettingList& identity) {
     OutputSettings os;
     os.exr_half = false;  // exact: the resumed frame must be bit-identical
-    os.metadata[kCheckpointKey] = "1";
+    os.metadata.insert_or_assign(kCheckpointKey, std::string(1, '1'));
     os.metadata[kTilesKey] = encode_done(frame.done);
-    for (const auto& [key, value] : identity) os.metadata[kSettingPrefix + key] = value;
+    for (const auto& [key, value] : identity) {
+        std::string name = kSettingPrefix;  // appended: `prefix + key` trips a -Wrestrict false positive
+        name += key;
+        os.metadata[name] = value;
+    }
     write_image(frame.film, path, os);
 }
 
@@ -48,7 +54,9 @@ void resume_from(const std::string& path, const SettingList& identity, FrameResu
     const Film saved = read_film(path, &meta);
     if (!meta.count(kCheckpointKey)) throw Error(fmt::format("{}: not a whitted checkpoint", path));
     for (const auto& [key, value] : identity) {
-        const auto it = meta.find(kSettingPrefix + key);
+        std::string name = kSettingPrefix;
+        name += key;
+        const auto it = meta.find(name);
         const std::string was = it == meta.end() ? "(not recorded)" : it->second;
         if (was != value)
             throw Error(fmt::format("{}: made with {} = {}, this render has {} = {} (render without --resume to "
@@ -112,7 +120,7 @@ std::string file_identity(const std::string& path) {
     return fmt::format("{} bytes, fnv1a64 {:016x}", size, hash);
 }
 
-FrameResult render_frame(const Renderer& renderer, const FrameOptions& options) {
+FrameResult render_frame(const Renderer& renderer, const FrameOptions& options, TileHelpers* helpers) {
     FrameResult frame;
     frame.tiles = renderer.tiles();
     frame.done.assign(frame.tiles.size(), 0);
@@ -123,16 +131,21 @@ FrameResult render_frame(const Renderer& renderer, const FrameOptions& options) 
         log_info("resumed {} of {} tiles from {}", frame.resumed, frame.tiles.size(), options.checkpoint_path);
     }
 
+    // The frame's state, shared by this process's workers and the helpers' server thread.
+    std::mutex state;
     ProgressBar progress(frame.tiles.size() - frame.resumed, options.progress);
     size_t cursor = 0;
     auto last_save = Clock::now();
     auto next = [&]() -> std::optional<size_t> {
+        const std::lock_guard<std::mutex> lock(state);
         if (options.stop && options.stop->load()) return std::nullopt;
         while (cursor < frame.tiles.size() && frame.done[cursor]) ++cursor;
         if (cursor == frame.tiles.size()) return std::nullopt;
         return cursor++;
     };
     auto done = [&](size_t tile, Film&& film) {
+        const std::lock_guard<std::mutex> lock(state);
+        RT_CHECK(tile < frame.tiles.size() && frame.film.can_paste(film));
         frame.film.paste(film);
         frame.done[tile] = 1;
         progress.advance();
@@ -143,11 +156,37 @@ FrameResult render_frame(const Renderer& renderer, const FrameOptions& options) 
             last_save = Clock::now();
         }
     };
-    renderer.render_tiles(next, done, &frame.stats);
+    if (!helpers) {
+        renderer.render_tiles(next, done, &frame.stats);
+    } else {
+        std::exception_ptr local_error;
+        RenderStats local;
+        std::thread own([&] {
+            try {
+                renderer.render_tiles(next, done, &local);
+            } catch (...) {
+                local_error = std::current_exception();
+            }
+        });
+        RenderStats remote;
+        try {
+            helpers->serve(next, done, remote, options.stop);
+        } catch (...) {
+            own.join();
+            throw;
+        }
+        own.join();
+        if (local_error) std::rethrow_exception(local_error);
+        frame.stats = local;
+        frame.stats.rays += remote.rays;
+        frame.stats.nonfinite_samples += remote.nonfinite_samples;
+        frame.stats.pixels += remote.pixels;
+        frame.stats.pixels_subdivided += remote.pixels_subdivided;
+        frame.stats.threads += remote.threads;
+    }
     progress.finish();
 
-    const std::vector<size_t> missing = frame.missing();
-    if (!missing.empty() && !options.checkpoint_path.empty()) {
+    if (!frame.missing().empty() && !options.checkpoint_path.empty()) {
         write_checkpoint(options.checkpoint_path, frame, options.identity);
         frame.checkpoint_written = true;
     }

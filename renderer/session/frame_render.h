@@ -38,12 +38,25 @@ struct FrameResult {
     std::vector<size_t> missing() const;
 };
 
+/// Other processes rendering tiles of the same frame (MPI ranks: mpi_frame.h). render_frame then
+/// renders its own tiles on a second thread and calls serve() on its own: serve hands tiles out
+/// with `take` (nothing once none are left or the render stops), gives finished ones back with
+/// `give`, adds the helpers' counters to `stats` and returns when every helper is done, or soon
+/// after `stop` is set when helpers have gone quiet (a dead rank must not keep the finished tiles
+/// from being written).
+class TileHelpers {
+public:
+    virtual ~TileHelpers() = default;
+    virtual void serve(const NextTile& take, const TileDone& give, RenderStats& stats,
+                       const std::atomic<bool>* stop) = 0;
+};
+
 /// Renders the frame's tiles in order, skipping those a resumed checkpoint holds. With
 /// options.stop set it returns early (tiles in flight finish first); when tiles are then missing
 /// and a checkpoint path is set, the checkpoint is written (the caller removes it once the finished
 /// frame is safely written). Throws whitted::Error naming the checkpoint when a resume finds none, a broken one,
 /// or one made otherwise (the first setting that differs).
-FrameResult render_frame(const Renderer& renderer, const FrameOptions& options);
+FrameResult render_frame(const Renderer& renderer, const FrameOptions& options, TileHelpers* helpers = nullptr);
 
 /// The tiles `which` as text, "x0,y0,x1,y1" each, space-separated (the metadata of a partial image).
 std::string describe_tiles(const std::vector<TileRect>& tiles, const std::vector<size_t>& which);

@@ -49,7 +49,11 @@ std::map<std::string, std::string> tile_job_metadata(const TileJob& job, const P
     std::map<std::string, std::string> meta;
     meta[kJobKey] = fmt::format("{}/{}", job.index, job.count);
     meta[kFrameKey] = window_text(frame);
-    for (const auto& [key, value] : identity) meta[kSettingPrefix + key] = value;
+    for (const auto& [key, value] : identity) {
+        std::string name = kSettingPrefix;  // appended: `prefix + key` trips a -Wrestrict false positive
+        name += key;
+        meta[name] = value;
+    }
     return meta;
 }
 
