@@ -177,6 +177,9 @@ FrameResult render_frame(const Renderer& renderer, const FrameOptions& options, 
         }
         own.join();
         if (local_error) std::rethrow_exception(local_error);
+        const double share = double(local.pixels) / double(std::max<uint64_t>(local.pixels + remote.pixels, 1));
+        log_info("tiles: {:.1f}% of the pixels rendered by this process, {:.1f}% by the helpers", 100.0 * share,
+                 100.0 * (1.0 - share));
         frame.stats = local;
         frame.stats.rays += remote.rays;
         frame.stats.nonfinite_samples += remote.nonfinite_samples;

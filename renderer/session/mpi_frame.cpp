@@ -3,7 +3,11 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdlib>
+#include <cstdio>
 #include <cstring>
+#include <deque>
+#include <iterator>
+#include <list>
 #include <thread>
 #include <type_traits>
 #include <vector>
@@ -110,21 +114,17 @@ std::pair<size_t, Film> unpack(const std::vector<uint8_t>& bytes, const Renderer
     return {tile, std::move(f)};
 }
 
-std::vector<uint8_t> receive_bytes(const MPI_Status& probe) {
-    int count = 0;
-    MPI_Get_count(&probe, MPI_BYTE, &count);
-    std::vector<uint8_t> bytes(size_t(std::max(count, 0)));
-    MPI_Recv(bytes.data(), count, MPI_BYTE, probe.MPI_SOURCE, probe.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-    return bytes;
-}
-
 }  // namespace
 
 bool mpi_available() { return true; }
 
 MpiSession::MpiSession(int* argc, char*** argv) {
     int provided = 0;
-    MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
+    MPI_Init_thread(argc, argv, MPI_THREAD_SERIALIZED, &provided);
+    if (provided < MPI_THREAD_SERIALIZED) {
+        MPI_Finalize();
+        throw Error("MPI: this MPI library does not support MPI_THREAD_SERIALIZED");
+    }
     MPI_Comm_rank(MPI_COMM_WORLD, &m_rank);
     MPI_Comm_size(MPI_COMM_WORLD, &m_size);
 }
@@ -156,22 +156,59 @@ void MpiTileServer::serve(const NextTile& take_tile, const TileDone& give, Rende
     const std::vector<TileRect> tiles = m_renderer.tiles();
     int working = m_mpi.size() - 1;  // ranks that have not sent their final counters
     auto last_message = Clock::now();
-    while (working > 0) {
+    // Tiles are received without blocking (matched probe, then MPI_Imrecv): a tile is larger than
+    // the eager limit, so its bytes move only when the sender next enters MPI, and a blocking
+    // receive would spin until then.
+    struct Incoming {
+        std::vector<uint8_t> bytes;
+        MPI_Request request = MPI_REQUEST_NULL;
+        int source = 0;
+    };
+    std::list<Incoming> incoming;
+    while (working > 0 || !incoming.empty()) {
+        bool progressed = false;
+        for (auto it = incoming.begin(); it != incoming.end();) {
+            int received = 0;
+            MPI_Test(&it->request, &received, MPI_STATUS_IGNORE);
+            if (!received) {
+                ++it;
+                continue;
+            }
+            auto [tile, film] = unpack(it->bytes, m_renderer, tiles, it->source);
+            give(tile, std::move(film));
+            it = incoming.erase(it);
+            progressed = true;
+        }
         int flag = 0;
+        MPI_Message message;
         MPI_Status probe;
-        MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &probe);
-        if (!flag) {  // nothing yet: give the core to this rank's own tiles
+        MPI_Improbe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &message, &probe);
+        if (!flag) {
+            if (progressed) continue;
             // Interrupted (a signal, or the launcher ending the job for a dead rank): the tiles in
             // flight arrive within moments; ranks silent for half a second are not waited for.
             if (stop && stop->load() && Clock::now() - last_message > std::chrono::milliseconds(500)) {
                 log_warning("MPI: {} rank(s) did not finish after the interrupt; their tiles stay missing", working);
+                for (Incoming& in : incoming) MPI_Cancel(&in.request);
                 return;
             }
-            std::this_thread::sleep_for(std::chrono::microseconds(200));
+            // Nothing yet: give the core to this rank's own tiles (the others ask for the next
+            // tiles while half of their batch is left, so this wait does not stall them).
+            std::this_thread::sleep_for(std::chrono::microseconds(500));
             continue;
         }
         last_message = Clock::now();
-        const std::vector<uint8_t> bytes = receive_bytes(probe);
+        int count = 0;
+        MPI_Get_count(&probe, MPI_BYTE, &count);
+        if (probe.MPI_TAG == kResult) {
+            Incoming& in = incoming.emplace_back();
+            in.bytes.resize(size_t(std::max(count, 0)));
+            in.source = probe.MPI_SOURCE;
+            MPI_Imrecv(in.bytes.data(), count, MPI_BYTE, &message, &in.request);
+            continue;
+        }
+        std::vector<uint8_t> bytes(size_t(std::max(count, 0)));
+        MPI_Mrecv(bytes.data(), count, MPI_BYTE, &message, MPI_STATUS_IGNORE);
         if (probe.MPI_TAG == kRequest) {
             int want = 0;
             if (bytes.size() == sizeof(want)) std::memcpy(&want, bytes.data(), sizeof(want));
@@ -182,9 +219,6 @@ void MpiTileServer::serve(const NextTile& take_tile, const TileDone& give, Rende
                 assigned.push_back(uint32_t(*t));
             }
             MPI_Send(assigned.data(), int(assigned.size()), MPI_UINT32_T, probe.MPI_SOURCE, kAssign, MPI_COMM_WORLD);
-        } else if (probe.MPI_TAG == kResult) {
-            auto [tile, film] = unpack(bytes, m_renderer, tiles, probe.MPI_SOURCE);
-            give(tile, std::move(film));
         } else if (probe.MPI_TAG == kStats) {
             WorkerStats w;
             if (bytes.size() != sizeof(w)) throw Error(fmt::format("MPI: broken counters from rank {}", probe.MPI_SOURCE));
@@ -203,31 +237,76 @@ void MpiTileServer::serve(const NextTile& take_tile, const TileDone& give, Rende
 
 RenderStats serve_mpi_worker(const MpiSession& mpi, const Renderer& renderer) {
     (void)mpi;
-    // A few tiles per request, so that the next assignment arrives while these render.
+    // Tiles arrive a few at a time; the next batch is asked for while half of this one is left,
+    // so that it is on its way while these render.
     const int threads = renderer.settings().threads > 0 ? renderer.settings().threads
                                                          : int(std::thread::hardware_concurrency());
-    const int want = std::max(2, 2 * threads);
-    RenderStats stats;
-    MPI_Send(&want, 1, MPI_INT, 0, kRequest, MPI_COMM_WORLD);
-    for (;;) {
+    const int want = std::max(8, 8 * threads);
+    std::deque<uint32_t> queue;
+    bool asked = false, finished = false;
+    // Finished tiles go out without waiting: a tile is larger than the eager limit of shared
+    // memory, so a blocking send would wait for rank 0 to post its receive.
+    struct Outgoing {
+        std::vector<uint8_t> bytes;
+        MPI_Request request = MPI_REQUEST_NULL;
+    };
+    std::list<Outgoing> outgoing;
+    auto reap = [&](bool wait) {
+        for (auto it = outgoing.begin(); it != outgoing.end();) {
+            int sent = 0;
+            if (wait) {
+                MPI_Wait(&it->request, MPI_STATUS_IGNORE);
+                sent = 1;
+            } else {
+                MPI_Test(&it->request, &sent, MPI_STATUS_IGNORE);
+            }
+            it = sent ? outgoing.erase(it) : std::next(it);
+        }
+    };
+    auto receive_assignment = [&](bool block) {
+        int flag = 1;
         MPI_Status probe;
-        MPI_Probe(0, kAssign, MPI_COMM_WORLD, &probe);
+        if (block) MPI_Probe(0, kAssign, MPI_COMM_WORLD, &probe);
+        else MPI_Iprobe(0, kAssign, MPI_COMM_WORLD, &flag, &probe);
+        if (!flag) return;
         int count = 0;
         MPI_Get_count(&probe, MPI_UINT32_T, &count);
         std::vector<uint32_t> assigned(size_t(std::max(count, 0)));
         MPI_Recv(assigned.data(), count, MPI_UINT32_T, 0, kAssign, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-        if (assigned.empty()) break;
-        MPI_Send(&want, 1, MPI_INT, 0, kRequest, MPI_COMM_WORLD);  // the next batch, while this one renders
-        size_t handed = 0;
-        std::vector<std::vector<uint8_t>> results;
-        renderer.render_tiles(
-            [&]() -> std::optional<size_t> {
-                return handed < assigned.size() ? std::optional<size_t>(assigned[handed++]) : std::nullopt;
-            },
-            [&](size_t tile, Film&& film) { results.push_back(pack(uint32_t(tile), film)); }, &stats);
-        for (const std::vector<uint8_t>& r : results)
-            MPI_Send(r.data(), int(r.size()), MPI_BYTE, 0, kResult, MPI_COMM_WORLD);
+        asked = false;
+        if (assigned.empty()) finished = true;
+        queue.insert(queue.end(), assigned.begin(), assigned.end());
+    };
+    // render_tiles calls these one at a time (MPI_THREAD_SERIALIZED), from its worker threads.
+    auto next = [&]() -> std::optional<size_t> {
+        reap(false);
+        if (asked) receive_assignment(false);
+        for (;;) {
+            if (!finished && !asked && queue.size() <= size_t(want / 2)) {
+                MPI_Send(&want, 1, MPI_INT, 0, kRequest, MPI_COMM_WORLD);
+                asked = true;
+            }
+            if (!queue.empty()) {
+                const uint32_t t = queue.front();
+                queue.pop_front();
+                return t;
+            }
+            if (finished) return std::nullopt;
+            receive_assignment(true);
+        }
+    };
+    auto done = [&](size_t tile, Film&& film) {
+        Outgoing& o = outgoing.emplace_back();
+        o.bytes = pack(uint32_t(tile), film);
+        MPI_Isend(o.bytes.data(), int(o.bytes.size()), MPI_BYTE, 0, kResult, MPI_COMM_WORLD, &o.request);
+    };
+    RenderStats stats;
+    renderer.render_tiles(next, done, &stats);
+    while (!finished) {  // every worker thread stopped early (cannot happen: each asks until told)
+        receive_assignment(true);
+        queue.clear();
     }
+    reap(true);
     WorkerStats w;
     w.rays = stats.rays;
     w.nonfinite = stats.nonfinite_samples;

@@ -21,8 +21,8 @@ bool launched_by_mpi();
 /// Whether this build has MPI (Open MPI from Debian; CMake's find_package(MPI)).
 bool mpi_available();
 
-/// MPI for the life of the object (MPI_Init_thread, funneled: only the thread that made it calls
-/// MPI; MPI_Finalize at the end). One per process.
+/// MPI for the life of the object (MPI_Init_thread, serialized: any thread may call MPI, never
+/// two at once; MPI_Finalize at the end). One per process.
 class MpiSession {
 public:
     /// Throws whitted::Error when the build has no MPI.

@@ -37,11 +37,11 @@ std::string q(const fs::path& p) {
 }
 
 /// The mpirun line verified on this machine kind (../shared/STACK.md): as root, no ssh, ranks not
-/// pinned, the ob1 transport, ranks yielding while idle.
+/// pinned, the ob1 transport.
 std::string mpirun(int ranks) {
     return std::string("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_plm=isolated "
                        "OMPI_MCA_btl_vader_single_copy_mechanism=none '") +
-           WHITTED_MPIEXEC + "' --oversubscribe --bind-to none --mca pml ob1 --mca mpi_yield_when_idle 1 -n " +
+           WHITTED_MPIEXEC + "' --oversubscribe --bind-to none --mca pml ob1 -n " +
            std::to_string(ranks) + " '" + WHITTED_EXE + "' ";
 }
 
