@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -165,7 +166,30 @@ struct RenderCommand {
     double checkpoint_seconds = 0.0;            ///< > 0: save finished tiles this often
     bool resume = false;                        ///< continue from the checkpoint
     std::string checkpoint_file;                ///< empty: beside the output (checkpoint_path_for)
+    std::string tile_log;                       ///< CSV of per-tile times (docs/measurements/distributed.md)
 };
+
+const Clock::time_point g_process_start = Clock::now();
+
+/// `--tile-log`: one row per tile rendered by this process, with the run's start-up time (process
+/// start to the first tile) and the bytes a tile's message to MPI rank 0 takes.
+void write_tile_log(const std::string& path, const FrameResult& frame, const std::string& scene, int tile_size,
+                    int threads, double startup) {
+    std::ofstream out(path);
+    if (!out) throw Error(fmt::format("--tile-log: cannot write {}", path));
+    const AovSet& a = frame.film.aovs;
+    const size_t per_pixel = sizeof(Color) + (a.depth ? 4 : 0) + (a.normal ? 12 : 0) + (a.albedo ? 12 : 0) +
+                             (a.prim_id ? 4 : 0) + (a.inst_id ? 4 : 0) + (a.aa_samples ? 4 : 0);
+    out << "scene,tile_size,threads,startup,tile,x0,y0,x1,y1,seconds,bytes\n";
+    for (size_t i = 0; i < frame.tiles.size(); ++i) {
+        if (frame.tile_seconds[i] <= 0.0) continue;
+        const TileRect& t = frame.tiles[i];
+        const size_t bytes = 4 + per_pixel * size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0);
+        out << fmt::format("{},{},{},{:.6f},{},{},{},{},{},{:.9f},{}\n", scene, tile_size, threads, startup, i, t.x0,
+                           t.y0, t.x1, t.y1, frame.tile_seconds[i], bytes);
+    }
+    if (!out) throw Error(fmt::format("--tile-log: cannot write {}", path));
+}
 
 /// The environment flags (docs/environment.md), shared by `render` and `info`.
 void add_environment_options(CLI::App* app, ImportOptions& io) {
@@ -325,11 +349,14 @@ int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& 
         g_mpi_running.store(true);
         log_info("MPI: {} ranks, {} threads each", mpi->size(), renderer.settings().threads);
     }
+    const double startup = seconds_since(g_process_start);
     FrameResult frame = render_frame(renderer, fo, server ? &*server : nullptr);
     g_mpi_running.store(false);
     g_rendering.store(false);
     const RenderStats& stats = frame.stats;
     const Film& film = frame.film;
+    if (!c.tile_log.empty())
+        write_tile_log(c.tile_log, frame, fs::path(c.input).filename().string(), rs.tile_size, stats.threads, startup);
     const std::vector<size_t> missing = frame.missing();
     if (!missing.empty()) {
         os.metadata["whitted:missingTiles"] = describe_tiles(frame.tiles, missing);
@@ -524,6 +551,9 @@ int main(int argc, char** argv) {
     render->add_flag("--resume", rc.resume,
                      "Continue from the checkpoint: render only the tiles it lacks (refused when it was made with "
                      "other settings)");
+    render->add_option("--tile-log", rc.tile_log,
+                       "Write each tile's render time (and its message size to MPI rank 0) as CSV, for "
+                       "scripts/simulate_mpi.py");
     render->add_option("--checkpoint-file", rc.checkpoint_file,
                        "Checkpoint path (default: the output path + .checkpoint.exr)");
 

@@ -124,6 +124,8 @@ FrameResult render_frame(const Renderer& renderer, const FrameOptions& options, 
     FrameResult frame;
     frame.tiles = renderer.tiles();
     frame.done.assign(frame.tiles.size(), 0);
+    frame.tile_seconds.assign(frame.tiles.size(), 0.0);
+    std::vector<Clock::time_point> handed_at(frame.tiles.size());
     const ImageSize size = renderer.image_size();
     frame.film = Film(size.width, size.height, renderer.window(), renderer.settings().aovs);
     if (options.resume) {
@@ -141,6 +143,7 @@ FrameResult render_frame(const Renderer& renderer, const FrameOptions& options, 
         if (options.stop && options.stop->load()) return std::nullopt;
         while (cursor < frame.tiles.size() && frame.done[cursor]) ++cursor;
         if (cursor == frame.tiles.size()) return std::nullopt;
+        handed_at[cursor] = Clock::now();
         return cursor++;
     };
     auto done = [&](size_t tile, Film&& film) {
@@ -148,6 +151,7 @@ FrameResult render_frame(const Renderer& renderer, const FrameOptions& options, 
         RT_CHECK(tile < frame.tiles.size() && frame.film.can_paste(film));
         frame.film.paste(film);
         frame.done[tile] = 1;
+        frame.tile_seconds[tile] = std::chrono::duration<double>(Clock::now() - handed_at[tile]).count();
         progress.advance();
         if (options.checkpoint_seconds > 0 && !options.checkpoint_path.empty() &&
             std::chrono::duration<double>(Clock::now() - last_save).count() >= options.checkpoint_seconds) {

@@ -33,6 +33,7 @@ struct FrameResult {
     std::vector<TileRect> tiles; ///< Renderer::tiles()
     std::vector<uint8_t> done;   ///< per tile: finished (now or from the checkpoint)
     size_t resumed = 0;          ///< tiles taken from the checkpoint
+    std::vector<double> tile_seconds;  ///< per tile: from handed out to done (0: not rendered now)
     bool checkpoint_written = false;  ///< the checkpoint now holds this frame's finished tiles
     /// Indices of the unfinished tiles (empty when the frame is complete).
     std::vector<size_t> missing() const;

@@ -22,6 +22,7 @@ namespace fs = std::filesystem;
 using whitted::test::Result;
 using whitted::test::run;
 using whitted::test::slurp;
+using whitted::test::wait_exit;
 
 
 
@@ -335,19 +336,6 @@ pid_t start_slow_write(const fs::path& dir, const fs::path& err, int delay_ms) {
         ::usleep(50 * 1000);
     }
     return pid;
-}
-
-/// Waits up to `seconds` for `pid`; returns its exit code, or -1 when it was still running (then
-/// it is killed).
-int wait_exit(pid_t pid, double seconds) {
-    int status = 0;
-    for (int i = 0; i < int(seconds * 20); ++i) {
-        if (::waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        ::usleep(50 * 1000);
-    }
-    ::kill(pid, SIGKILL);
-    ::waitpid(pid, &status, 0);
-    return -1;
 }
 
 /// One SIGINT while the image is being written: the write completes (a whole file, never a

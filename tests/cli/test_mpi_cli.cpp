@@ -29,12 +29,7 @@ using whitted::test::slurp;
 
 const std::string kRoom = std::string(WHITTED_ASSETS_DIR) + "/scenes/glass_mirror_room.json";
 
-std::string q(const fs::path& p) {
-    std::string s = "'";  // appended: `"'" + ...` trips a -Wrestrict false positive in GCC 12
-    s += p.string();
-    s += '\'';
-    return s;
-}
+std::string q(const fs::path& p) { return whitted::test::quoted(p); }
 
 /// The mpirun line verified on this machine kind (../shared/STACK.md): as root, no ssh, ranks not
 /// pinned, the ob1 transport.

@@ -24,18 +24,14 @@ using whitted::test::Result;
 using whitted::test::run;
 using whitted::test::scratch_dir;
 using whitted::test::slurp;
+using whitted::test::wait_exit;
 
 const std::string kRoom = std::string(WHITTED_ASSETS_DIR) + "/scenes/glass_mirror_room.json";
 const std::string kBox = std::string(WHITTED_ASSETS_DIR) + "/gltf/Box/glTF-Binary/Box.glb";
 /// Long enough to interrupt (about 3-10 s on two cores), with every AOV.
 const std::string kSlow = "--width 640 --aa stratified --spp 16 --aov all --exr-float --no-progress";
 
-std::string q(const fs::path& p) {
-    std::string s = "'";  // appended: `"'" + ...` trips a -Wrestrict false positive in GCC 12
-    s += p.string();
-    s += '\'';
-    return s;
-}
+std::string q(const fs::path& p) { return whitted::test::quoted(p); }
 
 /// A string attribute of an image's header ("" when absent).
 std::string attribute(const fs::path& path, const std::string& name) {
@@ -53,18 +49,6 @@ pid_t start(const std::string& args, const fs::path& err) {
         ::_exit(127);
     }
     return pid;
-}
-
-/// Waits up to `seconds`; the exit code (128 + signal when killed), or -1 after killing it.
-int wait_exit(pid_t pid, double seconds) {
-    int status = 0;
-    for (int i = 0; i < int(seconds * 20); ++i) {
-        if (::waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        ::usleep(50 * 1000);
-    }
-    ::kill(pid, SIGKILL);
-    ::waitpid(pid, &status, 0);
-    return -1;
 }
 
 /// Waits (up to 20 s) until the render has started: the log line naming the camera.
@@ -202,6 +186,25 @@ TEST(Session, TileJobsMergeToTheOnePieceFrame) {
     ASSERT_EQ(run(crop + " --tile-job 2/2 -o " + q(dir / "c2.exr")).code, 0);
     ASSERT_EQ(run("merge " + q(dir / "c2.exr") + " " + q(dir / "c1.exr") + " --exr-float -o " + q(dir / "cm.exr")).code, 0);
     EXPECT_EQ(read_pixels(dir / "cm.exr"), read_pixels(dir / "crop.exr"));
+}
+
+// --tile-log: a row per tile with its time and message size, for scripts/simulate_mpi.py.
+TEST(Session, TileLogHasARowPerTile) {
+    const fs::path dir = scratch_dir("whitted_session", "tilelog");
+    const Result r = run("render " + q(kRoom) + " --width 100 --tile-size 16 --no-progress -o " + q(dir / "x.png") +
+                         " --tile-log " + q(dir / "tiles.csv"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto rows = whitted::test::read_csv(dir / "tiles.csv");
+    ASSERT_EQ(rows.size(), 7u * 5u);  // 100 x 67 in tiles of 16
+    double sum = 0;
+    for (const auto& row : rows) {
+        EXPECT_GT(whitted::test::num(row, "seconds"), 0.0);
+        const double w = whitted::test::num(row, "x1") - whitted::test::num(row, "x0");
+        const double h = whitted::test::num(row, "y1") - whitted::test::num(row, "y0");
+        EXPECT_EQ(whitted::test::num(row, "bytes"), 4 + 12 * w * h);
+        sum += w * h;
+    }
+    EXPECT_EQ(sum, 100.0 * 67.0);
 }
 
 // Parts that do not make one frame: one clear line naming the part, exit 1.

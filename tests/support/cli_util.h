@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -55,6 +56,27 @@ inline std::filesystem::path scratch_dir(const std::string& prefix, const std::s
     const std::filesystem::path dir = std::filesystem::temp_directory_path() / folder / name;
     std::filesystem::create_directories(dir);
     return dir;
+}
+
+/// `p` in single quotes, for the shell command lines the tests build.
+inline std::string quoted(const std::filesystem::path& p) {
+    std::string s = "'";  // appended: `"'" + ...` trips a -Wrestrict false positive in GCC 12
+    s += p.string();
+    s += '\'';
+    return s;
+}
+
+/// Waits up to `seconds` for child `pid`; its exit code (128 + signal when killed), or -1 when
+/// it was still running (then it is killed).
+inline int wait_exit(pid_t pid, double seconds) {
+    int status = 0;
+    for (int i = 0; i < int(seconds * 20); ++i) {
+        if (::waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        ::usleep(50 * 1000);
+    }
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+    return -1;
 }
 
 /// Whether `part` occurs in `s` (the tests' check on captured output).
