@@ -7,7 +7,8 @@ Each TILE_LOG is what `whitted render --tile-log FILE` writes (one row per tile:
 y1, seconds, bytes, and the run's scene, tile_size, threads, startup seconds). The model, the
 protocol of renderer/session/mpi_frame.cpp:
   - every rank starts after `startup` seconds (MPI_Init + load + accelerator build, measured);
-  - ranks 1..N-1 ask rank 0 for BATCH tiles and ask again when half of a batch is left; a request
+  - ranks 1..N-1 ask rank 0 for BATCH tiles and ask again when half of a batch is left; rank 0
+    gives at most (tiles left) / (2 N) of them (guided: batches shrink at the end); a request
     and its answer cost 2 * LATENCY plus rank 0's handling time;
   - rank 0 renders too, one tile at a time from the same queue (frame order);
   - a finished tile travels to rank 0 in LATENCY + bytes / BANDWIDTH (overlapped with rendering)
@@ -64,7 +65,8 @@ def simulate(durations, sizes, startup, ranks):
         if kind == 0:  # a request from rank r reaches rank 0
             start = max(time, t0_busy)
             t0_busy = start + PER_TILE_CPU
-            batch = list(range(next_tile, min(n, next_tile + BATCH)))
+            guided = max(1, min(BATCH, (n - next_tile) // (2 * ranks)))  # shrinking with the tiles left
+            batch = list(range(next_tile, min(n, next_tile + guided)))
             next_tile += len(batch)
             arrive = t0_busy + LATENCY
             heapq.heappush(events, (arrive, 1, r))

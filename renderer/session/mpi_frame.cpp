@@ -1,5 +1,6 @@
 #include "renderer/session/mpi_frame.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdlib>
@@ -165,6 +166,7 @@ void MpiTileServer::serve(const NextTile& take_tile, const TileDone& give, Rende
         int source = 0;
     };
     std::list<Incoming> incoming;
+    size_t handed_up_to = 0;  // tiles are handed out in frame order: those below are taken
     while (working > 0 || !incoming.empty()) {
         bool progressed = false;
         for (auto it = incoming.begin(); it != incoming.end();) {
@@ -212,11 +214,16 @@ void MpiTileServer::serve(const NextTile& take_tile, const TileDone& give, Rende
         if (probe.MPI_TAG == kRequest) {
             int want = 0;
             if (bytes.size() == sizeof(want)) std::memcpy(&want, bytes.data(), sizeof(want));
+            // Guided: batches shrink with the tiles left (at most what is left over twice the
+            // ranks), so the last tiles spread over every rank instead of waiting in a few queues.
+            const size_t left = tiles.size() - std::min(tiles.size(), handed_up_to);
+            const int batch = int(std::clamp<size_t>(left / (2 * size_t(m_mpi.size())), 1, size_t(std::max(want, 1))));
             std::vector<uint32_t> assigned;
-            for (int i = 0; i < want; ++i) {
+            for (int i = 0; i < batch; ++i) {
                 const std::optional<size_t> t = take_tile();
                 if (!t) break;
                 assigned.push_back(uint32_t(*t));
+                handed_up_to = std::max(handed_up_to, *t + 1);
             }
             MPI_Send(assigned.data(), int(assigned.size()), MPI_UINT32_T, probe.MPI_SOURCE, kAssign, MPI_COMM_WORLD);
         } else if (probe.MPI_TAG == kStats) {
