@@ -86,6 +86,9 @@ void install_interrupt_handlers() {
     sa.sa_flags = SA_RESTART;
     sigaction(SIGINT, &sa, nullptr);
     sigaction(SIGTERM, &sa, nullptr);
+    // Under mpirun, ^C and SIGTERM end the whole job at once; SIGUSR1 it passes on to the ranks
+    // and leaves the job running: `kill -USR1 <mpirun>` stops a distributed render gracefully.
+    if (g_mpi) sigaction(SIGUSR1, &sa, nullptr);
 }
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
@@ -259,7 +262,15 @@ bool setup_agreed(const MpiSession& mpi, const std::string& error) {
 
 int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& given, const MpiSession* mpi) {
     const bool root = !mpi || mpi->rank() == 0;
-    if (root) install_interrupt_handlers();
+    if (root) {
+        install_interrupt_handlers();
+    } else {
+        // mpirun passes ^C and SIGTERM on to every rank: rank 0 decides (no new tiles, write what
+        // is done); the others finish the tiles they hold and are then told there are no more.
+        std::signal(SIGINT, SIG_IGN);
+        std::signal(SIGTERM, SIG_IGN);
+        std::signal(SIGUSR1, SIG_IGN);
+    }
     // The scene file's settings fill what the flags did not set.
     RenderSettings& rs = c.render;
     OutputSettings& os = c.out;

@@ -159,4 +159,34 @@ TEST(Mpi, DeadRankEndsTheJobNamingIt) {
     EXPECT_TRUE(contains(slurp(err), "rank 1")) << slurp(err);
 }
 
+// Under mpirun, SIGUSR1 to mpirun (which passes it on and keeps the job) stops a distributed
+// render gracefully: rank 0 writes the finished tiles and the checkpoint; `--resume` under mpirun
+// finishes the single process's image.
+TEST(Mpi, Sigusr1StopsGracefullyAndResumeFinishesTheImage) {
+    const fs::path dir = scratch_dir("whitted_mpi", "usr1");
+    const std::string flags = " --width 640 --aa stratified --spp 16 --threads 1 --exr-float --no-progress -o ";
+    const fs::path out = dir / "out.exr", err = dir / "stderr.txt";
+    const Result one = run("render " + q(kRoom) + flags + q(dir / "one.exr"));
+    ASSERT_EQ(one.code, 0) << one.err;
+    const pid_t job = ::fork();
+    if (job == 0) {
+        // exec: the pid is mpirun's, which passes SIGUSR1 on to the ranks.
+        const std::string cmd = "exec env " + mpirun(2) + "render " + q(kRoom) + flags + q(out) + " 2>" + q(err) + " </dev/null";
+        ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    for (int i = 0; i < 400 && !contains(slurp(err), "MPI:"); ++i) ::usleep(50 * 1000);
+    ::usleep(1000 * 1000);
+    ASSERT_EQ(::kill(job, SIGUSR1), 0);
+    const int code = whitted::test::wait_exit(job, 20.0);
+    if (code == 0) GTEST_SKIP() << "the render finished before the signal";
+    EXPECT_NE(code, -1) << "the job did not end: " << slurp(err);
+    EXPECT_TRUE(contains(slurp(err), "continue with --resume")) << slurp(err);
+    ASSERT_TRUE(fs::exists(dir / "out.exr.checkpoint.exr")) << slurp(err);
+    const Result resumed = shell(mpirun(2) + "render " + q(kRoom) + flags + q(out) + " --resume", dir);
+    ASSERT_EQ(resumed.code, 0) << resumed.err;
+    EXPECT_TRUE(contains(resumed.err, "resumed")) << resumed.err;
+    EXPECT_EQ(read_pixels(out), read_pixels(dir / "one.exr"));
+}
+
 }  // namespace
