@@ -38,7 +38,10 @@ void setup_environment(Scene& scene, const ImportOptions& options) {
     env.extraction_threshold = kInfinity;
     const EnvironmentMap map(env, 0, EnvironmentMap::Use::SplitOnly);
     const EnvironmentLighting lighting = map.split(std::max(options.environment_lights, 0));
+    const size_t before = scene.lights.size();
     std::erase_if(scene.lights, [](const Light& l) { return l.is_default; });
+    if (scene.lights.size() != before)  // nor its warning: the environment lights the scene
+        std::erase_if(scene.warnings, [](const std::string& w) { return w.find("added the default light") != std::string::npos; });
     for (size_t k = 0; k < lighting.lights.size(); ++k) {
         Light light = to_directional_light(lighting.lights[k], fmt::format("environment light {}", k));
         light.from_environment = true;

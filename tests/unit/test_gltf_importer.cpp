@@ -552,6 +552,8 @@ TEST(GltfImporter, DefaultStudioEnvironment) {
         EXPECT_TRUE(l.from_environment);
         EXPECT_FALSE(l.is_default);
     }
+    // The default light is gone, and so is the warning that announced it.
+    for (const std::string& w : s.warnings) EXPECT_EQ(w.find("added the default light"), std::string::npos) << w;
     EXPECT_TRUE(s.environment->ambient_sh);
     ImportOptions none;
     none.no_environment = true;
