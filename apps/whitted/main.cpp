@@ -180,14 +180,11 @@ void write_tile_log(const std::string& path, const FrameResult& frame, const std
                     int threads, double startup) {
     std::ofstream out(path);
     if (!out) throw Error(fmt::format("--tile-log: cannot write {}", path));
-    const AovSet& a = frame.film.aovs;
-    const size_t per_pixel = sizeof(Color) + (a.depth ? 4 : 0) + (a.normal ? 12 : 0) + (a.albedo ? 12 : 0) +
-                             (a.prim_id ? 4 : 0) + (a.inst_id ? 4 : 0) + (a.aa_samples ? 4 : 0);
     out << "scene,tile_size,threads,startup,tile,x0,y0,x1,y1,seconds,bytes\n";
     for (size_t i = 0; i < frame.tiles.size(); ++i) {
         if (frame.tile_seconds[i] <= 0.0) continue;
         const TileRect& t = frame.tiles[i];
-        const size_t bytes = 4 + per_pixel * size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0);
+        const size_t bytes = tile_message_bytes(t, frame.film.aovs);
         out << fmt::format("{},{},{},{:.6f},{},{},{},{},{},{:.9f},{}\n", scene, tile_size, threads, startup, i, t.x0,
                            t.y0, t.x1, t.y1, frame.tile_seconds[i], bytes);
     }

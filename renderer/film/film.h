@@ -33,11 +33,8 @@ struct PixelWindow {
     bool operator==(const PixelWindow&) const = default;
 };
 
-/// A tile: a rectangle of pixels [x0, x1) x [y0, y1) in full-image coordinates.
-struct TileRect {
-    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-    bool operator==(const TileRect&) const = default;
-};
+/// A tile: a region of the image like any other (a tile's film has the tile as its window).
+using TileRect = PixelWindow;
 
 struct Film {
     int full_width = 0, full_height = 0;  ///< the display window

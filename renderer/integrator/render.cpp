@@ -151,14 +151,14 @@ void Renderer::render_tiles(const NextTile& next, const TileDone& done, RenderSt
         if (!index) return;
         RT_CHECK(*index < tiles.size());
         const TileRect& t = tiles[*index];
-        Film film(m_size.width, m_size.height, PixelWindow{t.x0, t.y0, t.x1, t.y1}, m_settings.aovs);
+        Film film(m_size.width, m_size.height, t, m_settings.aovs);
         PixelSampler sampler(camera, integrator, film, m_settings.aa, m_settings.exposure, 1);
         for (int pass = 0; pass < sampler.passes(); ++pass) sampler.render_tile(pass, t, 0, rays[size_t(worker)].value);
         const size_t repaired = film.sanitize_nonfinite();
         const std::lock_guard<std::mutex> lock(handing);
         nonfinite += sampler.nonfinite() + repaired;
         subdivided += sampler.subdivided();
-        pixels += uint64_t(t.x1 - t.x0) * uint64_t(t.y1 - t.y0);
+        pixels += uint64_t(t.width()) * uint64_t(t.height());
         done(*index, std::move(film));
     });
     if (nonfinite > 0) log_warning("{} samples were not finite and were set to 0", nonfinite);

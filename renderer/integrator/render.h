@@ -33,6 +33,17 @@ struct RenderStats {
     uint64_t pixels = 0;                  ///< pixels rendered (the window)
     uint64_t pixels_subdivided = 0;       ///< adaptive: pixels whose square was split at least once
     int threads = 0;                      ///< worker threads used
+
+    /// Adds the work of another part of the frame (tiles rendered elsewhere: another thread or rank):
+    /// its rays, repaired samples, pixels and threads.
+    RenderStats& add(const RenderStats& o) {
+        rays += o.rays;
+        nonfinite_samples += o.nonfinite_samples;
+        pixels += o.pixels;
+        pixels_subdivided += o.pixels_subdivided;
+        threads += o.threads;
+        return *this;
+    }
 };
 
 /// render_tiles(): the next tile to render (an index into Renderer::tiles()), or nothing when no

@@ -143,9 +143,13 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
             ++counters.shadow_skipped_zero;
             return;
         }
-        const Candidate e{&light, ls, ls.intensity * term, 0.f};
-        if (light.from_environment) environment.push_back({e.light, e.ls, e.potential, max_component(e.potential)});
-        else sum += shadowed(e);
+        Candidate e{&light, ls, ls.intensity * term, 0.f};
+        if (!light.from_environment) {
+            sum += shadowed(e);
+            return;
+        }
+        e.key = max_component(e.potential);
+        environment.push_back(e);
     };
     if constexpr (K.tables) {
         // Only the lights that can reach this object (SceneAnalysis light reach).

@@ -25,7 +25,6 @@ using Clock = std::chrono::steady_clock;
 
 constexpr const char* kCheckpointKey = "whitted:checkpoint";
 constexpr const char* kTilesKey = "whitted:checkpointTiles";
-constexpr const char* kSettingPrefix = "whitted:setting:";
 
 /// The done flags as a string of '0' and '1' (one per tile, readable in `oiiotool --info -v`).
 std::string encode_done(const std::vector<uint8_t>& done) {
@@ -39,11 +38,7 @@ void write_checkpoint(const std::string& path, const FrameResult& frame, const S
     os.exr_half = false;  // exact: the resumed frame must be bit-identical
     os.metadata.insert_or_assign(kCheckpointKey, std::string(1, '1'));
     os.metadata[kTilesKey] = encode_done(frame.done);
-    for (const auto& [key, value] : identity) {
-        std::string name = kSettingPrefix;  // appended: `prefix + key` trips a -Wrestrict false positive
-        name += key;
-        os.metadata[name] = value;
-    }
+    os.metadata.merge(identity_metadata(identity));
     write_image(frame.film, path, os);
 }
 
@@ -54,9 +49,7 @@ void resume_from(const std::string& path, const SettingList& identity, FrameResu
     const Film saved = read_film(path, &meta);
     if (!meta.count(kCheckpointKey)) throw Error(fmt::format("{}: not a whitted checkpoint", path));
     for (const auto& [key, value] : identity) {
-        std::string name = kSettingPrefix;
-        name += key;
-        const auto it = meta.find(name);
+        const auto it = meta.find(setting_key(key));
         const std::string was = it == meta.end() ? "(not recorded)" : it->second;
         if (was != value)
             throw Error(fmt::format("{}: made with {} = {}, this render has {} = {} (render without --resume to "
@@ -76,14 +69,6 @@ void resume_from(const std::string& path, const SettingList& identity, FrameResu
         frame.done[i] = c == '1';
         frame.resumed += frame.done[i];
     }
-    // The unfinished tiles start from the empty film's values, as in a fresh render.
-    const Film empty(saved.full_width, saved.full_height, saved.window, saved.aovs);
-    for (size_t i = 0; i < frame.tiles.size(); ++i) {
-        if (frame.done[i]) continue;
-        const TileRect& t = frame.tiles[i];
-        Film blank(empty.full_width, empty.full_height, PixelWindow{t.x0, t.y0, t.x1, t.y1}, empty.aovs);
-        frame.film.paste(blank);
-    }
 }
 
 }  // namespace
@@ -102,6 +87,18 @@ std::string describe_tiles(const std::vector<TileRect>& tiles, const std::vector
         s += fmt::format("{}{},{},{},{}", s.empty() ? "" : " ", t.x0, t.y0, t.x1, t.y1);
     }
     return s;
+}
+
+std::string setting_key(const std::string& name) {
+    std::string key = "whitted:setting:";  // appended: `prefix + name` trips a -Wrestrict false positive
+    key += name;
+    return key;
+}
+
+std::map<std::string, std::string> identity_metadata(const SettingList& identity) {
+    std::map<std::string, std::string> meta;
+    for (const auto& [name, value] : identity) meta[setting_key(name)] = value;
+    return meta;
 }
 
 std::string checkpoint_path_for(const std::string& output) { return output + ".checkpoint.exr"; }
@@ -156,7 +153,6 @@ FrameResult render_frame(const Renderer& renderer, const FrameOptions& options, 
         if (options.checkpoint_seconds > 0 && !options.checkpoint_path.empty() &&
             std::chrono::duration<double>(Clock::now() - last_save).count() >= options.checkpoint_seconds) {
             write_checkpoint(options.checkpoint_path, frame, options.identity);
-            frame.checkpoint_written = true;
             last_save = Clock::now();
         }
     };
@@ -185,18 +181,12 @@ FrameResult render_frame(const Renderer& renderer, const FrameOptions& options, 
         log_info("tiles: {:.1f}% of the pixels rendered by this process, {:.1f}% by the helpers", 100.0 * share,
                  100.0 * (1.0 - share));
         frame.stats = local;
-        frame.stats.rays += remote.rays;
-        frame.stats.nonfinite_samples += remote.nonfinite_samples;
-        frame.stats.pixels += remote.pixels;
-        frame.stats.pixels_subdivided += remote.pixels_subdivided;
-        frame.stats.threads += remote.threads;
+        frame.stats.add(remote);
     }
     progress.finish();
 
-    if (!frame.missing().empty() && !options.checkpoint_path.empty()) {
+    if (!frame.missing().empty() && !options.checkpoint_path.empty())
         write_checkpoint(options.checkpoint_path, frame, options.identity);
-        frame.checkpoint_written = true;
-    }
     return frame;
 }
 

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -34,7 +35,6 @@ struct FrameResult {
     std::vector<uint8_t> done;   ///< per tile: finished (now or from the checkpoint)
     size_t resumed = 0;          ///< tiles taken from the checkpoint
     std::vector<double> tile_seconds;  ///< per tile: from handed out to done (0: not rendered now)
-    bool checkpoint_written = false;  ///< the checkpoint now holds this frame's finished tiles
     /// Indices of the unfinished tiles (empty when the frame is complete).
     std::vector<size_t> missing() const;
 };
@@ -61,6 +61,12 @@ FrameResult render_frame(const Renderer& renderer, const FrameOptions& options, 
 
 /// The tiles `which` as text, "x0,y0,x1,y1" each, space-separated (the metadata of a partial image).
 std::string describe_tiles(const std::vector<TileRect>& tiles, const std::vector<size_t>& which);
+
+/// The metadata key a checkpoint or a tile-job part records setting `name` under:
+/// "whitted:setting:<name>".
+std::string setting_key(const std::string& name);
+/// `identity` as metadata (setting_key of each name).
+std::map<std::string, std::string> identity_metadata(const SettingList& identity);
 
 /// Default checkpoint path beside an output image: "<output>.checkpoint.exr".
 std::string checkpoint_path_for(const std::string& output);

@@ -24,6 +24,13 @@
 
 namespace whitted {
 
+size_t tile_message_bytes(const PixelWindow& tile, const AovSet& a) {
+    const size_t per_pixel = sizeof(Color) + (a.depth ? sizeof(float) : 0) + (a.normal ? sizeof(Vec3f) : 0) +
+                             (a.albedo ? sizeof(Color) : 0) + (a.prim_id ? sizeof(uint32_t) : 0) +
+                             (a.inst_id ? sizeof(uint32_t) : 0) + (a.aa_samples ? sizeof(float) : 0);
+    return sizeof(uint32_t) + per_pixel * size_t(tile.width()) * size_t(tile.height());
+}
+
 bool launched_by_mpi() {
     for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE", "MPI_LOCALNRANKS"})
         if (std::getenv(v)) return true;
@@ -48,13 +55,8 @@ namespace {
 
 enum Tag : int { kRequest = 1, kAssign = 2, kResult = 3, kStats = 4 };
 
-/// What a worker reports at the end (raw bytes: the ranks run the same build).
-struct WorkerStats {
-    RayCounters rays;
-    uint64_t nonfinite = 0, pixels = 0, subdivided = 0;
-    int threads = 0;
-};
-static_assert(std::is_trivially_copyable_v<WorkerStats>);
+// A worker's counters travel as RenderStats' raw bytes: the ranks run the same build.
+static_assert(std::is_trivially_copyable_v<RenderStats>);
 
 template <typename T>
 uint8_t* put(uint8_t* p, const std::vector<T>& v) {
@@ -68,16 +70,9 @@ const uint8_t* take(const uint8_t* p, std::vector<T>& v) {
     return p + v.size() * sizeof(T);
 }
 
-/// Bytes of pack()'s message for a film.
-size_t packed_size(const Film& f) {
-    return sizeof(uint32_t) + f.beauty.size() * sizeof(Color) + f.depth.size() * sizeof(float) +
-           f.normal.size() * sizeof(Vec3f) + f.albedo.size() * sizeof(Color) + f.prim_id.size() * sizeof(uint32_t) +
-           f.inst_id.size() * sizeof(uint32_t) + f.aa_samples.size() * sizeof(float);
-}
-
 /// A finished tile as one message: its index, then every buffer of its film.
 std::vector<uint8_t> pack(uint32_t tile, const Film& f) {
-    std::vector<uint8_t> out(packed_size(f));
+    std::vector<uint8_t> out(tile_message_bytes(f.window, f.aovs));
     uint8_t* p = out.data();
     std::memcpy(p, &tile, sizeof(tile));
     p += sizeof(tile);
@@ -100,8 +95,8 @@ std::pair<size_t, Film> unpack(const std::vector<uint8_t>& bytes, const Renderer
     if (tile >= tiles.size()) throw Error(fmt::format("MPI: rank {} sent tile {} of {}", source, tile, tiles.size()));
     const TileRect& t = tiles[tile];
     const ImageSize size = renderer.image_size();
-    Film f(size.width, size.height, PixelWindow{t.x0, t.y0, t.x1, t.y1}, renderer.settings().aovs);
-    const size_t expected = packed_size(f);
+    Film f(size.width, size.height, t, renderer.settings().aovs);
+    const size_t expected = tile_message_bytes(f.window, f.aovs);
     if (bytes.size() != expected)
         throw Error(fmt::format("MPI: rank {} sent {} bytes for tile {}, expected {}", source, bytes.size(), tile, expected));
     const uint8_t* p = bytes.data() + sizeof(tile);
@@ -227,14 +222,10 @@ void MpiTileServer::serve(const NextTile& take_tile, const TileDone& give, Rende
             }
             MPI_Send(assigned.data(), int(assigned.size()), MPI_UINT32_T, probe.MPI_SOURCE, kAssign, MPI_COMM_WORLD);
         } else if (probe.MPI_TAG == kStats) {
-            WorkerStats w;
+            RenderStats w;
             if (bytes.size() != sizeof(w)) throw Error(fmt::format("MPI: broken counters from rank {}", probe.MPI_SOURCE));
             std::memcpy(&w, bytes.data(), sizeof(w));
-            stats.rays += w.rays;
-            stats.nonfinite_samples += w.nonfinite;
-            stats.pixels += w.pixels;
-            stats.pixels_subdivided += w.subdivided;
-            stats.threads += w.threads;
+            stats.add(w);
             --working;
         } else {
             throw Error(fmt::format("MPI: unexpected message tag {} from rank {}", probe.MPI_TAG, probe.MPI_SOURCE));
@@ -309,18 +300,12 @@ RenderStats serve_mpi_worker(const MpiSession& mpi, const Renderer& renderer) {
     };
     RenderStats stats;
     renderer.render_tiles(next, done, &stats);
-    while (!finished) {  // every worker thread stopped early (cannot happen: each asks until told)
-        receive_assignment(true);
-        queue.clear();
-    }
+    // render_tiles runs one iteration per tile of the frame: when this rank got every tile, the
+    // last iteration rendered one, and rank 0's closing (empty) answer is still to be read.
+    while (!finished) receive_assignment(true);
+    RT_CHECK(queue.empty());
     reap(true);
-    WorkerStats w;
-    w.rays = stats.rays;
-    w.nonfinite = stats.nonfinite_samples;
-    w.pixels = stats.pixels;
-    w.subdivided = stats.pixels_subdivided;
-    w.threads = stats.threads;
-    MPI_Send(&w, int(sizeof(w)), MPI_BYTE, 0, kStats, MPI_COMM_WORLD);
+    MPI_Send(&stats, int(sizeof(stats)), MPI_BYTE, 0, kStats, MPI_COMM_WORLD);
     return stats;
 }
 

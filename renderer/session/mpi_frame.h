@@ -18,6 +18,9 @@ namespace whitted {
 /// variables), found without initialising MPI: a plain run never touches it.
 bool launched_by_mpi();
 
+/// Bytes of a finished tile's message to rank 0: its index, then every buffer of its film.
+size_t tile_message_bytes(const PixelWindow& tile, const AovSet& aovs);
+
 /// Whether this build has MPI (Open MPI from Debian; CMake's find_package(MPI)).
 bool mpi_available();
 

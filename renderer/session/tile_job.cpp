@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "renderer/core/error.h"
+#include "renderer/session/frame_render.h"
 
 namespace whitted {
 
@@ -13,7 +14,6 @@ namespace {
 
 constexpr const char* kJobKey = "whitted:tileJob";
 constexpr const char* kFrameKey = "whitted:frameWindow";
-constexpr const char* kSettingPrefix = "whitted:setting:";
 
 std::string window_text(const PixelWindow& w) { return fmt::format("{},{},{},{}", w.x0, w.y0, w.x1, w.y1); }
 
@@ -46,18 +46,14 @@ PixelWindow tile_job_window(const PixelWindow& frame, const TileJob& job) {
 
 std::map<std::string, std::string> tile_job_metadata(const TileJob& job, const PixelWindow& frame,
                                                      const SettingList& identity) {
-    std::map<std::string, std::string> meta;
+    std::map<std::string, std::string> meta = identity_metadata(identity);
     meta[kJobKey] = fmt::format("{}/{}", job.index, job.count);
     meta[kFrameKey] = window_text(frame);
-    for (const auto& [key, value] : identity) {
-        std::string name = kSettingPrefix;  // appended: `prefix + key` trips a -Wrestrict false positive
-        name += key;
-        meta[name] = value;
-    }
     return meta;
 }
 
 Film merge_parts(const std::vector<std::string>& paths, std::map<std::string, std::string>* metadata) {
+    const std::string setting_prefix = setting_key("");
     if (paths.empty()) throw Error("merge: no parts given");
     std::vector<Part> parts;
     for (const std::string& path : paths) {
@@ -81,11 +77,11 @@ Film merge_parts(const std::vector<std::string>& paths, std::map<std::string, st
             throw Error(fmt::format("{}: part {}/{} of another job than {} ({}/{})", p.path, p.job.index, p.job.count,
                                     first.path, first.job.index, first.job.count));
         for (const auto& [key, value] : first.meta) {
-            if (key.rfind(kSettingPrefix, 0) != 0 && key != kFrameKey) continue;
+            if (key.rfind(setting_prefix, 0) != 0 && key != kFrameKey) continue;
             const auto it = p.meta.find(key);
             const std::string other = it == p.meta.end() ? "(not recorded)" : it->second;
             if (other != value) {
-                const std::string name = key == kFrameKey ? "frame" : key.substr(std::string(kSettingPrefix).size());
+                const std::string name = key == kFrameKey ? "frame" : key.substr(setting_prefix.size());
                 throw Error(fmt::format("{}: made with {} = {}, but {} with {} = {}", p.path, name, other, first.path,
                                         name, value));
             }
@@ -132,7 +128,7 @@ Film merge_parts(const std::vector<std::string>& paths, std::map<std::string, st
     if (metadata) {
         metadata->clear();
         for (const auto& [key, value] : first.meta)
-            if (key.rfind(kSettingPrefix, 0) == 0) (*metadata)[key] = value;
+            if (key.rfind(setting_prefix, 0) == 0) (*metadata)[key] = value;
     }
     return film;
 }

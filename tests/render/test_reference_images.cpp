@@ -33,7 +33,7 @@ struct ImageCase {
     bool refract_thin = false;
     bool scene_settings = false;  ///< a scene file: apply its render settings, then the size above
     bool no_environment = false;  ///< the default light instead of the default studio environment
-    std::string environment;      ///< an environment to light it with (ImportOptions::environment)
+    std::string environment{};    ///< an environment to light it with (ImportOptions::environment)
 };
 
 std::ostream& operator<<(std::ostream& os, const ImageCase& c) { return os << c.name; }
