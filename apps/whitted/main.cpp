@@ -56,7 +56,7 @@ std::atomic<bool> g_stop{false};
 // Under MPI, once the ranks render together an error on one rank ends them all (MPI_Abort):
 // the others would wait for it forever.
 std::atomic<bool> g_mpi_running{false};
-const whitted::MpiSession* g_mpi = nullptr;
+whitted::MpiSession* g_mpi = nullptr;
 
 extern "C" void on_interrupt(int sig) {
     g_last_signal.store(sig);
@@ -170,6 +170,7 @@ struct RenderCommand {
     bool resume = false;                        ///< continue from the checkpoint
     std::string checkpoint_file;                ///< empty: beside the output (checkpoint_path_for)
     std::string tile_log;                       ///< CSV of per-tile times (docs/measurements/distributed.md)
+    TileOrder tile_order = TileOrder::ExpensiveFirst;
 };
 
 const Clock::time_point g_process_start = Clock::now();
@@ -180,13 +181,14 @@ void write_tile_log(const std::string& path, const FrameResult& frame, const std
                     int threads, double startup) {
     std::ofstream out(path);
     if (!out) throw Error(fmt::format("--tile-log: cannot write {}", path));
-    out << "scene,tile_size,threads,startup,tile,x0,y0,x1,y1,seconds,bytes\n";
+    out << "scene,tile_size,threads,startup,tile,x0,y0,x1,y1,seconds,bytes,cost\n";
     for (size_t i = 0; i < frame.tiles.size(); ++i) {
         if (frame.tile_seconds[i] <= 0.0) continue;
         const TileRect& t = frame.tiles[i];
         const size_t bytes = tile_message_bytes(t, frame.film.aovs);
-        out << fmt::format("{},{},{},{:.6f},{},{},{},{},{},{:.9f},{}\n", scene, tile_size, threads, startup, i, t.x0,
-                           t.y0, t.x1, t.y1, frame.tile_seconds[i], bytes);
+        const double cost = frame.tile_cost.empty() ? 0.0 : frame.tile_cost[i];
+        out << fmt::format("{},{},{},{:.6f},{},{},{},{},{},{:.9f},{},{:.0f}\n", scene, tile_size, threads, startup, i,
+                           t.x0, t.y0, t.x1, t.y1, frame.tile_seconds[i], bytes, cost);
     }
     if (!out) throw Error(fmt::format("--tile-log: cannot write {}", path));
 }
@@ -257,7 +259,7 @@ bool setup_agreed(const MpiSession& mpi, const std::string& error) {
     return false;
 }
 
-int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& given, const MpiSession* mpi) {
+int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& given, MpiSession* mpi) {
     const bool root = !mpi || mpi->rank() == 0;
     if (root) {
         install_interrupt_handlers();
@@ -316,7 +318,9 @@ int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& 
         if (!mpi || mpi->size() == 1) throw;
         setup_error = e.what();
     }
-    if (mpi && mpi->size() > 1 && !setup_agreed(*mpi, setup_error)) return 1;
+    // The ranks agree on the set-up; rank 0, when its own succeeded, agrees once it serves tiles
+    // (MpiTileServer), rendering its own meanwhile.
+    if (mpi && mpi->size() > 1 && (!root || !setup_error.empty()) && !setup_agreed(*mpi, setup_error)) return 1;
     const Renderer& renderer = *renderer_ptr;
     if (mpi && mpi->size() > 1 && !root) {  // a worker rank: tiles for rank 0, nothing else
         g_mpi_running.store(true);
@@ -350,6 +354,7 @@ int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& 
     fo.resume = c.resume;
     fo.stop = &g_stop;
     fo.progress = rs.progress;
+    fo.order = c.tile_order;
     g_rendering.store(true);
     std::optional<MpiTileServer> server;
     if (mpi && mpi->size() > 1) {
@@ -360,6 +365,8 @@ int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& 
     const double startup = seconds_since(g_process_start);
     FrameResult frame = render_frame(renderer, fo, server ? &*server : nullptr);
     g_mpi_running.store(false);
+    // Every tile is in: MPI ends (the other ranks exit) while this rank writes the image.
+    if (mpi) mpi->finish();
     g_rendering.store(false);
     const RenderStats& stats = frame.stats;
     const Film& film = frame.film;
@@ -444,7 +451,7 @@ int main(int argc, char** argv) {
     // run never initialises it (docs/distributed.md).
     std::optional<MpiSession> mpi;
     if (launched_by_mpi() && mpi_available()) {
-        mpi.emplace(&argc, &argv);
+        mpi.emplace();
         g_mpi = &*mpi;
     }
     CLI::App app{"whitted: a Whitted-style (1980) recursive ray tracer for glTF 2.0 scenes"};
@@ -562,6 +569,13 @@ int main(int argc, char** argv) {
     render->add_option("--tile-log", rc.tile_log,
                        "Write each tile's render time (and its message size to MPI rank 0) as CSV, for "
                        "scripts/simulate_mpi.py");
+    render->add_option_function<std::string>(
+              "--tile-order",
+              [&rc](const std::string& v) { rc.tile_order = v == "frame" ? TileOrder::Frame : TileOrder::ExpensiveFirst; },
+              "Order the tiles are rendered in: cost (the dearest first, by a probe of 16 rays per tile, so "
+              "that the last tiles are cheap) or frame (row by row)")
+        ->check(CLI::IsMember({"cost", "frame"}))
+        ->default_str("cost");
     render->add_option("--checkpoint-file", rc.checkpoint_file,
                        "Checkpoint path (default: the output path + .checkpoint.exr)");
 
@@ -641,6 +655,9 @@ int main(int argc, char** argv) {
         if (merge->parsed()) return run_merge(merge_parts_in, merge_output, merge_out, command_line(argc, argv));
         for (app::Command& c : commands)
             if (c.app->parsed()) return c.run();
+    } catch (const MpiSetupFailed& e) {
+        std::fprintf(stderr, "whitted: error: %s\n", e.what());
+        return 1;
     } catch (const Error& e) {
         if (g_mpi && g_mpi_running.load()) {
             std::fprintf(stderr, "whitted: error: rank %d: %s\n", g_mpi->rank(), e.what());

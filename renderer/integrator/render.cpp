@@ -173,4 +173,50 @@ void Renderer::render_tiles(const NextTile& next, const TileDone& done, RenderSt
     }
 }
 
+std::vector<double> Renderer::tile_costs(int probes) const {
+    if (probes < 2) throw Error(fmt::format("tile_costs: {} probes per side (expected at least 2)", probes));
+    const CameraModel camera(m_scene.cameras[size_t(m_settings.camera)], m_size.width, m_size.height);
+    const WhittedIntegrator integrator(m_view, *m_accel, m_settings.integrator);
+    const RayCone cone = camera.pixel_cone();
+    const AaSettings& aa = m_settings.aa;
+    const std::vector<TileRect> tiles = this->tiles();
+    std::vector<double> cost(tiles.size(), 0.0);
+    WorkerPool pool(m_settings.threads);
+    pool.for_each(tiles.size(), [&](size_t i, int) {
+        const TileRect& t = tiles[i];
+        RayCounters counters;
+        std::vector<Color> seen(size_t(probes * probes));
+        for (int py = 0; py < probes; ++py)
+            for (int px = 0; px < probes; ++px) {
+                const double x = t.x0 + (px + 0.5) * t.width() / probes;
+                const double y = t.y0 + (py + 0.5) * t.height() / probes;
+                seen[size_t(py * probes + px)] =
+                    integrator.trace(camera.generate(x, y), RayKind::Camera, 0, counters, nullptr, cone);
+            }
+        const double pixels = double(t.width()) * double(t.height());
+        double samples = pixels;
+        if (aa.mode == AaMode::Adaptive) {
+            // Edges subdivide: neighbouring probes that differ as the adaptive test measures say an
+            // edge crosses between them, about half a probe spacing of pixels per pair, each pixel on
+            // an edge adding about 3 * 2^depth samples (the sub-squares along the edge, level by level).
+            auto differ = [&](const Color& a, const Color& b) {
+                const float e = m_settings.exposure;
+                return aa.threshold < 0.f || aa_contrast(a * e, b * e, a * e, b * e) > aa.threshold;
+            };
+            int edges = 0;
+            for (int py = 0; py < probes; ++py)
+                for (int px = 0; px < probes; ++px) {
+                    const Color& c = seen[size_t(py * probes + px)];
+                    if (px + 1 < probes && differ(c, seen[size_t(py * probes + px + 1)])) ++edges;
+                    if (py + 1 < probes && differ(c, seen[size_t((py + 1) * probes + px)])) ++edges;
+                }
+            const double spacing = 0.5 * double(t.width() + t.height()) / probes;
+            const double subdivided = std::min(pixels, 0.5 * spacing * edges);
+            samples += subdivided * 3.0 * double(1 << aa.depth);
+        }
+        cost[i] = double(counters.total()) / double(probes * probes) * samples;
+    });
+    return cost;
+}
+
 }  // namespace whitted

@@ -1,5 +1,7 @@
 #include "renderer/session/frame_render.h"
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <exception>
 #include <filesystem>
@@ -133,15 +135,51 @@ FrameResult render_frame(const Renderer& renderer, const FrameOptions& options, 
     // The frame's state, shared by this process's workers and the helpers' server thread.
     std::mutex state;
     ProgressBar progress(frame.tiles.size() - frame.resumed, options.progress);
+    // The tiles to render, in the order they are handed out, and their estimated work (1 each in
+    // frame order).
+    std::vector<size_t> order;
+    for (size_t i = 0; i < frame.tiles.size(); ++i)
+        if (!frame.done[i]) order.push_back(i);
+    std::vector<double> work(frame.tiles.size(), 1.0);
+    // The order matters only where tiles render side by side.
+    const bool side_by_side = helpers != nullptr || renderer.settings().threads != 1;
+    if (options.order == TileOrder::ExpensiveFirst && side_by_side && order.size() > 1) {
+        const auto t_probe = Clock::now();
+        frame.tile_cost = renderer.tile_costs();
+        log_debug("tile order: costs of {} tiles estimated in {:.3f}s", frame.tile_cost.size(),
+                  std::chrono::duration<double>(Clock::now() - t_probe).count());
+        work = frame.tile_cost;
+        std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return work[a] > work[b]; });
+    }
+    double work_left = 0.0;  // of the tiles not yet handed out
+    for (const size_t t : order) work_left += work[t];
     size_t cursor = 0;
     auto last_save = Clock::now();
+    std::atomic<bool> abandoned{false};  // the helpers failed: no new tiles
+    // Under the lock.
+    auto hand_out = [&]() -> std::optional<size_t> {
+        if ((options.stop && options.stop->load()) || abandoned.load() || cursor == order.size()) return std::nullopt;
+        const size_t tile = order[cursor++];
+        work_left = cursor == order.size() ? 0.0 : std::max(0.0, work_left - work[tile]);
+        handed_at[tile] = Clock::now();
+        return tile;
+    };
     auto next = [&]() -> std::optional<size_t> {
         const std::lock_guard<std::mutex> lock(state);
-        if (options.stop && options.stop->load()) return std::nullopt;
-        while (cursor < frame.tiles.size() && frame.done[cursor]) ++cursor;
-        if (cursor == frame.tiles.size()) return std::nullopt;
-        handed_at[cursor] = Clock::now();
-        return cursor++;
+        return hand_out();
+    };
+    auto take = [&](size_t max_tiles, double share) {
+        const std::lock_guard<std::mutex> lock(state);
+        std::vector<size_t> batch;
+        const double budget = share * work_left;
+        double taken = 0.0;
+        while (batch.size() < max_tiles && (batch.empty() || taken < budget)) {
+            const std::optional<size_t> tile = hand_out();
+            if (!tile) break;
+            batch.push_back(*tile);
+            taken += work[*tile];
+        }
+        return batch;
     };
     auto done = [&](size_t tile, Film&& film) {
         const std::lock_guard<std::mutex> lock(state);
@@ -170,8 +208,9 @@ FrameResult render_frame(const Renderer& renderer, const FrameOptions& options, 
         });
         RenderStats remote;
         try {
-            helpers->serve(next, done, remote, options.stop);
+            helpers->serve(take, done, remote, options.stop);
         } catch (...) {
+            abandoned.store(true);
             own.join();
             throw;
         }

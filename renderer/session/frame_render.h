@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -18,6 +19,12 @@
 
 namespace whitted {
 
+/// The order render_frame hands tiles out in.
+enum class TileOrder {
+    Frame,          ///< row-major, as Renderer::tiles() numbers them
+    ExpensiveFirst  ///< by Renderer::tile_costs(), the dearest first, so that the last tiles are cheap
+};
+
 struct FrameOptions {
     SettingList identity;                     ///< what the pixels depend on (settings, scene, version); a
                                               ///< checkpoint records it and a resume must match it
@@ -26,6 +33,7 @@ struct FrameOptions {
     bool resume = false;                      ///< start from checkpoint_path's finished tiles
     const std::atomic<bool>* stop = nullptr;  ///< once true, no new tile starts (set by a signal handler)
     bool progress = false;                    ///< progress bar over the tiles on stderr
+    TileOrder order = TileOrder::ExpensiveFirst;
 };
 
 struct FrameResult {
@@ -35,24 +43,30 @@ struct FrameResult {
     std::vector<uint8_t> done;   ///< per tile: finished (now or from the checkpoint)
     size_t resumed = 0;          ///< tiles taken from the checkpoint
     std::vector<double> tile_seconds;  ///< per tile: from handed out to done (0: not rendered now)
+    std::vector<double> tile_cost;     ///< per tile: the estimate it was ordered by (empty: frame order)
     /// Indices of the unfinished tiles (empty when the frame is complete).
     std::vector<size_t> missing() const;
 };
 
+/// TileHelpers::serve: up to `max_tiles` of the next tiles in the frame's order for one helper,
+/// fewer once the estimated work of those taken reaches `share` of the work not yet handed out
+/// (guided: batches shrink as the frame nears its end; at least one tile); none once every tile is
+/// handed out or the render stops.
+using TakeTiles = std::function<std::vector<size_t>(size_t max_tiles, double share)>;
+
 /// Other processes rendering tiles of the same frame (MPI ranks: mpi_frame.h). render_frame then
 /// renders its own tiles on a second thread and calls serve() on its own: serve hands tiles out
-/// with `take` (nothing once none are left or the render stops), gives finished ones back with
-/// `give`, adds the helpers' counters to `stats` and returns when every helper is done, or soon
-/// after `stop` is set when helpers have gone quiet (a dead rank must not keep the finished tiles
-/// from being written).
+/// with `take`, gives finished ones back with `give`, adds the helpers' counters to `stats` and
+/// returns when every helper is done, or soon after `stop` is set when helpers have gone quiet (a
+/// dead rank must not keep the finished tiles from being written).
 class TileHelpers {
 public:
     virtual ~TileHelpers() = default;
-    virtual void serve(const NextTile& take, const TileDone& give, RenderStats& stats,
+    virtual void serve(const TakeTiles& take, const TileDone& give, RenderStats& stats,
                        const std::atomic<bool>* stop) = 0;
 };
 
-/// Renders the frame's tiles in order, skipping those a resumed checkpoint holds. With
+/// Renders the frame's tiles in options.order, skipping those a resumed checkpoint holds. With
 /// options.stop set it returns early (tiles in flight finish first); when tiles are then missing
 /// and a checkpoint path is set, the checkpoint is written (the caller removes it once the finished
 /// frame is safely written). Throws whitted::Error naming the checkpoint when a resume finds none, a broken one,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <cstdlib>
 #include <cstdio>
@@ -9,8 +10,12 @@
 #include <deque>
 #include <iterator>
 #include <list>
+#include <mutex>
+#include <string>
 #include <thread>
+#include <tuple>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -39,19 +44,27 @@ bool launched_by_mpi() {
 
 #if !WHITTED_HAVE_MPI
 
+struct MpiSession::Lifetime {};
 bool mpi_available() { return false; }
-MpiSession::MpiSession(int*, char***) { throw Error("this whitted was built without MPI"); }
+MpiSession::MpiSession() { throw Error("this whitted was built without MPI"); }
 MpiSession::~MpiSession() = default;
+int MpiSession::rank() const { return 0; }
+int MpiSession::size() const { return 1; }
 bool MpiSession::all(bool ok) const { return ok; }
 bool MpiSession::from_root(bool value) const { return value; }
 void MpiSession::abort(int code) const { std::exit(code); }
+void MpiSession::finish() {}
+void MpiSession::ready() const {}
 MpiTileServer::MpiTileServer(const MpiSession& mpi, const Renderer& renderer) : m_mpi(mpi), m_renderer(renderer) {}
-void MpiTileServer::serve(const NextTile&, const TileDone&, RenderStats&, const std::atomic<bool>*) {}
+void MpiTileServer::serve(const TakeTiles&, const TileDone&, RenderStats&, const std::atomic<bool>*) {}
 RenderStats serve_mpi_worker(const MpiSession&, const Renderer&) { return {}; }
 
 #else
 
 namespace {
+
+/// A batch's most of the estimated work left, times the number of ranks.
+constexpr double kBatchShare = 1.0 / 16.0;
 
 enum Tag : int { kRequest = 1, kAssign = 2, kResult = 3, kStats = 4 };
 
@@ -114,41 +127,127 @@ std::pair<size_t, Film> unpack(const std::vector<uint8_t>& bytes, const Renderer
 
 bool mpi_available() { return true; }
 
-MpiSession::MpiSession(int* argc, char*** argv) {
-    int provided = 0;
-    MPI_Init_thread(argc, argv, MPI_THREAD_SERIALIZED, &provided);
-    if (provided < MPI_THREAD_SERIALIZED) {
-        MPI_Finalize();
-        throw Error("MPI: this MPI library does not support MPI_THREAD_SERIALIZED");
+/// MPI's state, owned by the thread that starts and ends it (MPI_Finalize belongs on the thread
+/// that called MPI_Init_thread).
+struct MpiSession::Lifetime {
+    std::thread thread;
+    std::mutex mutex;
+    std::condition_variable changed;
+    bool up = false;         // MPI_Init_thread has returned
+    bool finishing = false;  // finish(): MPI_Finalize may run
+    std::string error;       // why MPI cannot be used, once up
+    int rank = -1, size = -1;
+    int launcher_rank = -1, launcher_size = -1;  // from the environment, when it says
+};
+
+namespace {
+
+/// The launcher's word for this process's rank and the job's size (Open MPI, then MPICH's PMI);
+/// {-1, -1} when it does not say.
+std::pair<int, int> launcher_rank() {
+    for (const auto& [rank, size] : {std::pair{"OMPI_COMM_WORLD_RANK", "OMPI_COMM_WORLD_SIZE"},
+                                     std::pair{"PMI_RANK", "PMI_SIZE"}}) {
+        const char* r = std::getenv(rank);
+        const char* n = std::getenv(size);
+        if (r && n && *r && *n) return {std::atoi(r), std::atoi(n)};
     }
-    MPI_Comm_rank(MPI_COMM_WORLD, &m_rank);
-    MPI_Comm_size(MPI_COMM_WORLD, &m_size);
+    return {-1, -1};
 }
 
-MpiSession::~MpiSession() { MPI_Finalize(); }
+}  // namespace
+
+MpiSession::MpiSession() : m(std::make_unique<Lifetime>()) {
+    std::tie(m->launcher_rank, m->launcher_size) = launcher_rank();
+    m->thread = std::thread([l = m.get()] {
+        int provided = 0, rank = 0, size = 1;
+        MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
+        MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+        MPI_Comm_size(MPI_COMM_WORLD, &size);
+        std::unique_lock<std::mutex> lock(l->mutex);
+        if (provided < MPI_THREAD_SERIALIZED)
+            l->error = "MPI: this MPI library does not support MPI_THREAD_SERIALIZED";
+        else if (l->launcher_rank >= 0 && (l->launcher_rank != rank || l->launcher_size != size))
+            l->error = fmt::format("MPI: the launcher says rank {} of {}, MPI says rank {} of {}", l->launcher_rank,
+                                   l->launcher_size, rank, size);
+        l->rank = rank;
+        l->size = size;
+        l->up = true;
+        l->changed.notify_all();
+        l->changed.wait(lock, [l] { return l->finishing; });
+        lock.unlock();
+        MPI_Finalize();
+    });
+}
+
+MpiSession::~MpiSession() {
+    finish();
+    m->thread.join();
+}
+
+void MpiSession::ready() const {
+    std::unique_lock<std::mutex> lock(m->mutex);
+    RT_CHECK(!m->finishing);
+    m->changed.wait(lock, [this] { return m->up; });
+    if (!m->error.empty()) throw Error(m->error);
+}
+
+int MpiSession::rank() const {
+    if (m->launcher_rank >= 0) return m->launcher_rank;
+    ready();
+    return m->rank;
+}
+
+int MpiSession::size() const {
+    if (m->launcher_size >= 0) return m->launcher_size;
+    ready();
+    return m->size;
+}
+
+void MpiSession::finish() {
+    const std::lock_guard<std::mutex> lock(m->mutex);
+    m->finishing = true;
+    m->changed.notify_all();
+}
 
 bool MpiSession::all(bool ok) const {
+    ready();
     int mine = ok ? 1 : 0, every = 0;
     MPI_Allreduce(&mine, &every, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
     return every == 1;
 }
 
 bool MpiSession::from_root(bool value) const {
+    ready();
     int v = value ? 1 : 0;
     MPI_Bcast(&v, 1, MPI_INT, 0, MPI_COMM_WORLD);
     return v == 1;
 }
 
 void MpiSession::abort(int code) const {
-    MPI_Abort(MPI_COMM_WORLD, code);
+    bool finishing = false;
+    {
+        const std::lock_guard<std::mutex> lock(m->mutex);
+        finishing = m->finishing;
+    }
+    if (!finishing) {
+        ready();
+        MPI_Abort(MPI_COMM_WORLD, code);
+    }
     std::exit(code);
 }
 
 MpiTileServer::MpiTileServer(const MpiSession& mpi, const Renderer& renderer) : m_mpi(mpi), m_renderer(renderer) {}
 
-void MpiTileServer::serve(const NextTile& take_tile, const TileDone& give, RenderStats& stats,
+void MpiTileServer::serve(const TakeTiles& take, const TileDone& give, RenderStats& stats,
                           const std::atomic<bool>* stop) {
     using Clock = std::chrono::steady_clock;
+    // The other ranks' set-up, agreed here rather than before the render (this rank's own set-up
+    // succeeded, or it would not serve), so that this rank's tiles start while MPI and the other
+    // ranks are still starting. The ranks that failed have said why.
+    if (!m_mpi.all(true)) {
+        m_mpi.from_root(false);
+        throw MpiSetupFailed();
+    }
     const std::vector<TileRect> tiles = m_renderer.tiles();
     int working = m_mpi.size() - 1;  // ranks that have not sent their final counters
     auto last_message = Clock::now();
@@ -161,7 +260,6 @@ void MpiTileServer::serve(const NextTile& take_tile, const TileDone& give, Rende
         int source = 0;
     };
     std::list<Incoming> incoming;
-    size_t handed_up_to = 0;  // tiles are handed out in frame order: those below are taken
     while (working > 0 || !incoming.empty()) {
         bool progressed = false;
         for (auto it = incoming.begin(); it != incoming.end();) {
@@ -209,17 +307,12 @@ void MpiTileServer::serve(const NextTile& take_tile, const TileDone& give, Rende
         if (probe.MPI_TAG == kRequest) {
             int want = 0;
             if (bytes.size() == sizeof(want)) std::memcpy(&want, bytes.data(), sizeof(want));
-            // Guided: batches shrink with the tiles left (at most what is left over twice the
-            // ranks), so the last tiles spread over every rank instead of waiting in a few queues.
-            const size_t left = tiles.size() - std::min(tiles.size(), handed_up_to);
-            const int batch = int(std::clamp<size_t>(left / (2 * size_t(m_mpi.size())), 1, size_t(std::max(want, 1))));
+            // Guided by the estimated work: a batch holds at most 1/(16 N) of the work left, so the
+            // last tiles spread over every rank instead of waiting in a few queues (the factor chosen
+            // with scripts/simulate_mpi.py, docs/measurements/distributed.md).
             std::vector<uint32_t> assigned;
-            for (int i = 0; i < batch; ++i) {
-                const std::optional<size_t> t = take_tile();
-                if (!t) break;
-                assigned.push_back(uint32_t(*t));
-                handed_up_to = std::max(handed_up_to, *t + 1);
-            }
+            for (const size_t t : take(size_t(std::max(want, 1)), kBatchShare / double(m_mpi.size())))
+                assigned.push_back(uint32_t(t));
             MPI_Send(assigned.data(), int(assigned.size()), MPI_UINT32_T, probe.MPI_SOURCE, kAssign, MPI_COMM_WORLD);
         } else if (probe.MPI_TAG == kStats) {
             RenderStats w;
