@@ -170,7 +170,7 @@ struct RenderCommand {
     bool resume = false;                        ///< continue from the checkpoint
     std::string checkpoint_file;                ///< empty: beside the output (checkpoint_path_for)
     std::string tile_log;                       ///< CSV of per-tile times (docs/measurements/distributed.md)
-    TileOrder tile_order = TileOrder::ExpensiveFirst;
+    TileOrder tile_order = TileOrder::Auto;
 };
 
 const Clock::time_point g_process_start = Clock::now();
@@ -571,11 +571,14 @@ int main(int argc, char** argv) {
                        "scripts/simulate_mpi.py");
     render->add_option_function<std::string>(
               "--tile-order",
-              [&rc](const std::string& v) { rc.tile_order = v == "frame" ? TileOrder::Frame : TileOrder::ExpensiveFirst; },
-              "Order the tiles are rendered in: cost (the dearest first, by a probe of 16 rays per tile, so "
-              "that the last tiles are cheap) or frame (row by row)")
-        ->check(CLI::IsMember({"cost", "frame"}))
-        ->default_str("cost");
+              [&rc](const std::string& v) {
+                  rc.tile_order = v == "frame" ? TileOrder::Frame : v == "cost" ? TileOrder::ExpensiveFirst : TileOrder::Auto;
+              },
+              "Order the tiles are rendered in: cost (the dearest first, by a probe of 16 ray trees per tile, so "
+              "that the last tiles are cheap), frame (row by row), or auto (cost from 8 worker threads over all "
+              "processes on, else frame)")
+        ->check(CLI::IsMember({"auto", "cost", "frame"}))
+        ->default_str("auto");
     render->add_option("--checkpoint-file", rc.checkpoint_file,
                        "Checkpoint path (default: the output path + .checkpoint.exr)");
 

@@ -49,8 +49,10 @@ struct WorkerPool::Impl {
     FtzObserver observer;
 };
 
+int resolve_threads(int threads) { return threads > 0 ? threads : tbb::this_task_arena::max_concurrency(); }
+
 WorkerPool::WorkerPool(int threads) {
-    m_size = threads > 0 ? threads : tbb::this_task_arena::max_concurrency();
+    m_size = resolve_threads(threads);
     m_impl = std::make_unique<Impl>(m_size);
 }
 

@@ -9,6 +9,9 @@
 
 namespace whitted {
 
+/// The worker count a `threads` setting means: itself when positive, else all hardware threads.
+int resolve_threads(int threads);
+
 class WorkerPool {
 public:
     /// `threads` workers, the calling thread among them; 0 = all hardware threads.

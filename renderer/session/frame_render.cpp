@@ -15,6 +15,7 @@
 
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
+#include "renderer/core/parallel.h"
 #include "renderer/core/progress.h"
 #include "renderer/output/image_output.h"
 
@@ -141,9 +142,10 @@ FrameResult render_frame(const Renderer& renderer, const FrameOptions& options, 
     for (size_t i = 0; i < frame.tiles.size(); ++i)
         if (!frame.done[i]) order.push_back(i);
     std::vector<double> work(frame.tiles.size(), 1.0);
-    // The order matters only where tiles render side by side.
-    const bool side_by_side = helpers != nullptr || renderer.settings().threads != 1;
-    if (options.order == TileOrder::ExpensiveFirst && side_by_side && order.size() > 1) {
+    const int workers = resolve_threads(renderer.settings().threads) + (helpers ? helpers->workers() : 0);
+    const bool expensive_first = options.order == TileOrder::ExpensiveFirst ||
+                                 (options.order == TileOrder::Auto && workers >= kExpensiveFirstWorkers);
+    if (expensive_first && order.size() > 1) {
         const auto t_probe = Clock::now();
         frame.tile_cost = renderer.tile_costs();
         log_debug("tile order: costs of {} tiles estimated in {:.3f}s", frame.tile_cost.size(),

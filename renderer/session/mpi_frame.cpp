@@ -22,6 +22,7 @@
 
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
+#include "renderer/core/parallel.h"
 
 #if WHITTED_HAVE_MPI
 #include <mpi.h>
@@ -57,6 +58,7 @@ void MpiSession::finish() {}
 void MpiSession::ready() const {}
 MpiTileServer::MpiTileServer(const MpiSession& mpi, const Renderer& renderer) : m_mpi(mpi), m_renderer(renderer) {}
 void MpiTileServer::serve(const TakeTiles&, const TileDone&, RenderStats&, const std::atomic<bool>*) {}
+int MpiTileServer::workers() const { return 0; }
 RenderStats serve_mpi_worker(const MpiSession&, const Renderer&) { return {}; }
 
 #else
@@ -238,6 +240,11 @@ void MpiSession::abort(int code) const {
 
 MpiTileServer::MpiTileServer(const MpiSession& mpi, const Renderer& renderer) : m_mpi(mpi), m_renderer(renderer) {}
 
+int MpiTileServer::workers() const {
+    // Every rank runs with the same flags; `--threads 0` is taken as this host's count.
+    return (m_mpi.size() - 1) * resolve_threads(m_renderer.settings().threads);
+}
+
 void MpiTileServer::serve(const TakeTiles& take, const TileDone& give, RenderStats& stats,
                           const std::atomic<bool>* stop) {
     using Clock = std::chrono::steady_clock;
@@ -330,9 +337,7 @@ RenderStats serve_mpi_worker(const MpiSession& mpi, const Renderer& renderer) {
     (void)mpi;
     // Tiles arrive a few at a time; the next batch is asked for while half of this one is left,
     // so that it is on its way while these render.
-    const int threads = renderer.settings().threads > 0 ? renderer.settings().threads
-                                                         : int(std::thread::hardware_concurrency());
-    const int want = std::max(8, 8 * threads);
+    const int want = std::max(8, 8 * resolve_threads(renderer.settings().threads));
     std::deque<uint32_t> queue;
     bool asked = false, finished = false;
     // Finished tiles go out without waiting: a tile is larger than the eager limit of shared

@@ -69,6 +69,7 @@ public:
     MpiTileServer(const MpiSession& mpi, const Renderer& renderer);
     void serve(const TakeTiles& take, const TileDone& give, RenderStats& stats,
                const std::atomic<bool>* stop) override;
+    int workers() const override;
 
 private:
     const MpiSession& m_mpi;

@@ -61,7 +61,7 @@ TEST(Mpi, EveryRankCountGivesTheSingleProcessImage) {
     const Case cases[] = {{"--aa adaptive --threads 1", {1, 2, 3, 4}},
                           {"--aa stratified --spp 4 --threads 2 --tile-size 13", {2, 3}},
                           {"--aa corners --threads 1 --tile-size 200", {2}},
-                          {"--aa adaptive --threads 1 --tile-order frame", {3}}};
+                          {"--aa adaptive --threads 1 --tile-order cost", {3}}};
     for (const Case& c : cases) {
         const std::string common = "render " + q(kRoom) + " --width 160 --aov all --exr-float --no-progress " + c.flags;
         const Result one = run(common + " -o " + q(dir / "one.exr"));

@@ -99,7 +99,7 @@ TEST(TileOrder, AdaptiveCostsCountTheEdges) {
 /// A helper rendering in this process what it takes, batch by batch, and recording the batches.
 class RecordingHelper : public TileHelpers {
 public:
-    explicit RecordingHelper(const Renderer& r) : m_renderer(r) {}
+    explicit RecordingHelper(const Renderer& r, int workers = 1) : m_renderer(r), m_workers(workers) {}
     void serve(const TakeTiles& take, const TileDone& give, RenderStats& stats, const std::atomic<bool>*) override {
         for (;;) {
             const std::vector<size_t> batch = take(4, 0.3);
@@ -111,10 +111,12 @@ public:
             }, give, &stats);
         }
     }
+    int workers() const override { return m_workers; }
     std::vector<std::vector<size_t>> batches;
 
 private:
     const Renderer& m_renderer;
+    int m_workers;
 };
 
 TEST(TileOrder, DearestFirstWithGuidedBatchesMakesTheSameImage) {
@@ -159,6 +161,19 @@ TEST(TileOrder, DearestFirstWithGuidedBatchesMakesTheSameImage) {
             EXPECT_GT(largest, 1u);
         }
     }
+}
+
+TEST(TileOrder, AutoEstimatesCostsFromEightWorkersOn) {
+    const Scene s = floor_mirror_glass();
+    const Renderer r(s, settings(1, AaMode::Adaptive));
+    for (const int helpers : {1, 6, 7, 20}) {
+        FrameOptions fo;  // TileOrder::Auto
+        RecordingHelper helper(r, helpers);
+        const FrameResult frame = render_frame(r, fo, &helper);
+        EXPECT_EQ(!frame.tile_cost.empty(), 1 + helpers >= kExpensiveFirstWorkers) << helpers << " helper workers";
+    }
+    FrameOptions fo;
+    EXPECT_TRUE(render_frame(r, fo).tile_cost.empty());  // one thread alone
 }
 
 }  // namespace
