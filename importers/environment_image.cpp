@@ -12,6 +12,7 @@
 
 #include "importers/image_decode.h"
 #include "importers/one_line.h"
+#include "renderer/core/data_files.h"
 #include "renderer/core/error.h"
 #include "shading/environment_map.h"
 
@@ -36,13 +37,14 @@ std::string resolve_environment_name(const std::string& name) {
     if (std::filesystem::is_regular_file(name, ec)) return name;
     const auto& names = bundled_environment_names();
     if (std::find(names.begin(), names.end(), name) != names.end())
-        return std::string(WHITTED_SOURCE_DIR) + "/assets/environments/" + name + ".exr";
+        return data_file("environments/" + name + ".exr");
     throw Error(fmt::format("environment '{}': no such file, and not a bundled name ({})", name, fmt::join(names, ", ")));
 }
 
 bool is_bundled_environment(const std::string& path) {
     for (const std::string& name : bundled_environment_names())
-        if (path == std::string(WHITTED_SOURCE_DIR) + "/assets/environments/" + name + ".exr") return true;
+        for (const std::string& c : data_file_candidates("environments/" + name + ".exr"))
+            if (path == c) return true;
     return false;
 }
 

@@ -93,43 +93,6 @@ void install_interrupt_handlers() {
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-/// "r,g,b" or a single gray value.
-Color parse_color(const std::string& text, const char* flag) {
-    std::vector<float> v;
-    std::stringstream in(text);
-    std::string part;
-    while (std::getline(in, part, ',')) {
-        try {
-            size_t used = 0;
-            float f = std::stof(part, &used);
-            if (used != part.size() || !std::isfinite(f)) throw std::invalid_argument(part);
-            v.push_back(f);
-        } catch (const std::exception&) {
-            throw Error(fmt::format("{}: '{}' is not a color (expected r,g,b or a single value)", flag, text));
-        }
-    }
-    if (v.size() == 1) return Color(v[0]);
-    if (v.size() == 3) return {v[0], v[1], v[2]};
-    throw Error(fmt::format("{}: '{}' is not a color (expected r,g,b or a single value)", flag, text));
-}
-
-AovSet parse_aovs(const std::vector<std::string>& names) {
-    AovSet a;
-    for (const std::string& n : names) {
-        if (n == "depth" || n == "z") a.depth = true;
-        else if (n == "normal" || n == "n") a.normal = true;
-        else if (n == "albedo") a.albedo = true;
-        else if (n == "primid" || n == "prim_id" || n == "primitive") a.prim_id = true;
-        else if (n == "instid" || n == "inst_id" || n == "instance") a.inst_id = true;
-        else if (n == "aa_samples" || n == "aasamples") a.aa_samples = true;
-        else if (n == "all") a = AovSet{true, true, true, true, true, true};
-        else
-            throw Error(fmt::format(
-                "--aov: unknown AOV '{}' (available: depth, normal, albedo, primid, instid, aa_samples, all)", n));
-    }
-    return a;
-}
-
 std::string command_line(int argc, char** argv) {
     std::string s;
     for (int i = 0; i < argc; ++i) {
@@ -144,24 +107,13 @@ std::string color_text(const Color& c) {
     return c.x == c.y && c.y == c.z ? fmt::format("{}", c.x) : fmt::format("{},{},{}", c.x, c.y, c.z);
 }
 
-/// The library's RenderSettings with the command line's defaults: adaptive anti-aliasing, the
-/// adaptive tree depth at 1/255 and the progress bar (the library's are one centre ray per pixel,
-/// the depth limit only and no bar).
-RenderSettings cli_render_settings() {
-    RenderSettings rs;
-    rs.aa.mode = AaMode::Adaptive;
-    rs.integrator.min_weight = 1.f / 255.f;
-    rs.progress = true;
-    return rs;
-}
-
 /// What `whitted render` collects: the library's settings, which the flags set directly, and the
 /// few flags that are only other spellings of them.
 struct RenderCommand {
     std::string input;                          ///< scene file
     std::string output = "whitted.png";         ///< image file; the extension picks the format
     ImportOptions import;                       ///< glTF scene index, outside URIs
-    RenderSettings render = cli_render_settings();
+    RenderSettings render = command_line_render_settings();
     OutputSettings out;                         ///< OCIO config, display and view, bits, EXR half
     std::string precision, bv;                  ///< in-house BVH options appended to the --accel spec
     double max_memory_gb = 8.0;                 ///< ImportOptions::max_memory and the accelerators', in GiB

@@ -4,6 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "renderer/core/error.h"
 
 namespace whitted {
 
@@ -30,6 +34,50 @@ void merge_image_size(const SceneRenderSettings& s, RenderSettings& rs, bool wid
 }
 
 }  // namespace
+
+RenderSettings command_line_render_settings() {
+    RenderSettings rs;
+    rs.aa.mode = AaMode::Adaptive;
+    rs.integrator.min_weight = 1.f / 255.f;
+    rs.progress = true;
+    return rs;
+}
+
+Color parse_color(const std::string& text, const char* what) {
+    std::vector<float> v;
+    std::stringstream in(text);
+    std::string part;
+    while (std::getline(in, part, ',')) {
+        try {
+            size_t used = 0;
+            float f = std::stof(part, &used);
+            if (used != part.size() || !std::isfinite(f)) throw std::invalid_argument(part);
+            v.push_back(f);
+        } catch (const std::exception&) {
+            throw Error(fmt::format("{}: '{}' is not a color (expected r,g,b or a single value)", what, text));
+        }
+    }
+    if (v.size() == 1) return Color(v[0]);
+    if (v.size() == 3) return {v[0], v[1], v[2]};
+    throw Error(fmt::format("{}: '{}' is not a color (expected r,g,b or a single value)", what, text));
+}
+
+AovSet parse_aovs(const std::vector<std::string>& names) {
+    AovSet a;
+    for (const std::string& n : names) {
+        if (n == "depth" || n == "z") a.depth = true;
+        else if (n == "normal" || n == "n") a.normal = true;
+        else if (n == "albedo") a.albedo = true;
+        else if (n == "primid" || n == "prim_id" || n == "primitive") a.prim_id = true;
+        else if (n == "instid" || n == "inst_id" || n == "instance") a.inst_id = true;
+        else if (n == "aa_samples" || n == "aasamples") a.aa_samples = true;
+        else if (n == "all") a = AovSet{true, true, true, true, true, true};
+        else
+            throw Error(fmt::format(
+                "--aov: unknown AOV '{}' (available: depth, normal, albedo, primid, instid, aa_samples, all)", n));
+    }
+    return a;
+}
 
 void apply_scene_settings(const SceneRenderSettings& s, RenderSettings& rs, const SettingGiven& given) {
     auto from_file = [&](std::string_view key) { return !given || !given(key); };

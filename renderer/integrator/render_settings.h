@@ -31,6 +31,18 @@ struct RenderSettings {
     bool progress = false;                ///< progress bar with ETA on stderr (when it is a terminal)
 };
 
+/// The settings `whitted render` and the Python module start from: adaptive anti-aliasing, the
+/// adaptive tree depth at min_weight 1/255 and the progress bar (RenderSettings' own defaults
+/// are one centre ray per pixel, the depth limit only and no bar).
+RenderSettings command_line_render_settings();
+
+/// "r,g,b" or a single gray value; throws whitted::Error naming `what` (a flag) otherwise.
+Color parse_color(const std::string& text, const char* what);
+
+/// AOV names (depth/z, normal/n, albedo, primid, instid, aa_samples, all) as an AovSet; throws
+/// whitted::Error naming the unknown one and the choices.
+AovSet parse_aovs(const std::vector<std::string>& names);
+
 /// Fills every setting of `rs` the caller did not set (`given`) from a scene file's settings `s`
 /// (size, camera, anti-aliasing, depth, min weight, background, ambient, exposure in stops,
 /// Fresnel); what the file leaves unset keeps `rs`. An ambient from the file or the caller turns the

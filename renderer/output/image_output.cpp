@@ -30,6 +30,7 @@
 #include <OpenImageIO/half.h>
 #include <OpenImageIO/imageio.h>
 
+#include "renderer/core/data_files.h"
 #include "renderer/core/error.h"
 #include "renderer/core/log.h"
 
@@ -57,31 +58,11 @@ bool file_exists(const fs::path& p) {
 // ---- bundled config --------------------------------------------------------------------------
 
 std::string bundled_ocio_config() {
-    constexpr const char* kRelative = "ocio/config.ocio";
-    std::vector<fs::path> candidates;
-
-    // Relative to the running executable: installed tree first, then build trees inside or next
-    // to the source tree (build/apps/whitted, build/tests/test_x, build/whitted).
-    std::error_code ec;
-    fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-    if (!ec && !exe.empty()) {
-        fs::path dir = exe.parent_path();
-        candidates.push_back(dir / "../share/whitted" / kRelative);
-        candidates.push_back(dir / "../assets" / kRelative);
-        candidates.push_back(dir / "../../assets" / kRelative);
-        candidates.push_back(dir / "../../../assets" / kRelative);
+    try {
+        return data_file("ocio/config.ocio");
+    } catch (const Error& e) {
+        throw Error(fmt::format("bundled OCIO config: {}", e.what()));
     }
-    // The source tree this binary was configured from.
-#ifdef WHITTED_SOURCE_DIR
-    candidates.push_back(fs::path(WHITTED_SOURCE_DIR) / "assets" / kRelative);
-#endif
-
-    for (const fs::path& c : candidates)
-        if (file_exists(c)) return c.lexically_normal().string();
-
-    std::vector<std::string> tried;
-    for (const fs::path& c : candidates) tried.push_back(c.lexically_normal().string());
-    throw Error(fmt::format("bundled OCIO config not found (looked in: {})", join_names(tried)));
 }
 
 // ---- DisplayTransform ------------------------------------------------------------------------
@@ -176,6 +157,30 @@ const std::string& DisplayTransform::display() const { return m_impl->display; }
 const std::string& DisplayTransform::view() const { return m_impl->view; }
 
 // ---- image files -----------------------------------------------------------------------------
+
+std::vector<uint16_t> display_codes(std::span<const Color> pixels, const DisplayTransform& transform, int bits) {
+    if (bits != 8 && bits != 16) throw Error(fmt::format("unsupported bit depth {} (use 8 or 16)", bits));
+    // Sanitize before the transform: NaN -> 0 and +-inf -> +-65504 (half max), so that
+    // transforms mixing channels (the ACES matrices) never turn one bad channel into NaN.
+    constexpr float kLarge = 65504.f;
+    std::vector<float> rgb(pixels.size() * 3);
+    for (size_t i = 0; i < pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            const float v = pixels[i][c];
+            rgb[3 * i + size_t(c)] = std::isnan(v) ? 0.f : std::clamp(v, -kLarge, kLarge);
+        }
+    transform.apply(rgb.data(), pixels.size());
+    const float scale = bits == 16 ? 65535.f : 255.f;
+    std::vector<uint16_t> codes(rgb.size());
+    for (size_t i = 0; i < rgb.size(); ++i) {
+        // After the transform (OCIO does not clamp): NaN -> 0, then clamp to [0, 1] (+inf -> 1),
+        // then round to nearest. Deterministic: no dithering.
+        float v = rgb[i];
+        v = std::isnan(v) ? 0.f : std::clamp(v, 0.f, 1.f);
+        codes[i] = static_cast<uint16_t>(static_cast<uint32_t>(v * scale + 0.5f));
+    }
+    return codes;
+}
 
 namespace {
 
@@ -322,42 +327,24 @@ EncodedImage encode_display(const Film& film, FileKind kind, const OutputSetting
         throw Error(fmt::format("{}: unsupported bit depth {} (use 8 or 16)", path, settings.bits));
     if (bits == 16 && kind == FileKind::Jpeg) throw Error(fmt::format("{}: JPEG supports only 8 bits", path));
 
-    // Sanitize before the transform: NaN -> 0 and +-inf -> +-65504 (half max), so that
-    // transforms mixing channels (the ACES matrices) never turn one bad channel into NaN.
-    constexpr float kLarge = 65504.f;
-    std::vector<float> rgb(film.beauty.size() * 3);
-    for (size_t i = 0; i < film.beauty.size(); ++i)
-        for (int c = 0; c < 3; ++c) {
-            float v = film.beauty[i][c];
-            rgb[3 * i + size_t(c)] = std::isnan(v) ? 0.f : std::clamp(v, -kLarge, kLarge);
-        }
-
     std::optional<DisplayTransform> transform;
+    std::vector<uint16_t> codes;
     try {
         transform.emplace(settings.color);
+        codes = display_codes(film.beauty, *transform, bits);
     } catch (const Error& e) {
         throw Error(fmt::format("{}: {}", path, e.what()));
     }
-    transform->apply(rgb.data(), film.beauty.size());
 
     EncodedImage image;
     image.format = bits == 16 ? OIIO::TypeUInt16 : OIIO::TypeUInt8;
     image.spec = OIIO::ImageSpec(film.width(), film.height(), 3, image.format);
-    const float scale = bits == 16 ? 65535.f : 255.f;
-    const size_t bytes_per_value = bits == 16 ? 2 : 1;
-    image.bytes.resize(rgb.size() * bytes_per_value);
-    for (size_t i = 0; i < rgb.size(); ++i) {
-        // After the transform (OCIO does not clamp): NaN -> 0, then clamp to [0, 1] (+inf -> 1),
-        // then round to nearest. Deterministic: no dithering.
-        float v = rgb[i];
-        v = std::isnan(v) ? 0.f : std::clamp(v, 0.f, 1.f);
-        const auto code = static_cast<uint32_t>(v * scale + 0.5f);
-        if (bits == 16) {
-            const auto q = static_cast<uint16_t>(code);
-            std::memcpy(&image.bytes[2 * i], &q, 2);
-        } else {
-            image.bytes[i] = static_cast<unsigned char>(code);
-        }
+    if (bits == 16) {
+        image.bytes.resize(codes.size() * 2);
+        std::memcpy(image.bytes.data(), codes.data(), image.bytes.size());
+    } else {
+        image.bytes.resize(codes.size());
+        for (size_t i = 0; i < codes.size(); ++i) image.bytes[i] = static_cast<unsigned char>(codes[i]);
     }
 
     if (kind == FileKind::Tiff) image.spec.attribute("compression", "zip");

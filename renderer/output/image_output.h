@@ -2,7 +2,9 @@
 #pragma once
 
 #include <map>
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -40,6 +42,11 @@ private:
     struct Impl;
     std::unique_ptr<Impl> m_impl;
 };
+
+/// Display-referred codes of scene-linear pixels (RGB interleaved), exactly as write_image
+/// quantises PNG, JPEG and TIFF: NaN -> 0 and +-inf -> +-65504, the transform (OCIO), then
+/// clamped to [0, 1] and rounded to `bits` (8 or 16). Throws whitted::Error for other bit depths.
+std::vector<uint16_t> display_codes(std::span<const Color> pixels, const DisplayTransform& transform, int bits);
 
 struct OutputSettings {
     ColorSettings color;
