@@ -273,12 +273,17 @@ PYBIND11_MODULE(whitted, m) {
     PYBIND11_NUMPY_DTYPE(Hit, t, u, v, prim, geom, inst);
     m.doc() = "whitted: a Whitted-style (1980) recursive ray tracer for glTF 2.0 scenes (docs/python.md)";
     m.attr("__version__") = version();
+    // whitted.Error: the one-line message, and where: .file, .pointer (JSON pointer), .line.
     static py::exception<Error> error(m, "Error", PyExc_RuntimeError);
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);
         } catch (const Error& e) {
-            error(e.what());
+            py::object instance = py::reinterpret_borrow<py::object>(error.ptr())(e.what());
+            instance.attr("file") = e.location().file;
+            instance.attr("pointer") = e.location().pointer;
+            instance.attr("line") = e.location().line;
+            PyErr_SetObject(error.ptr(), instance.ptr());
         }
     });
     m.attr("accelerators") = accelerator_names();

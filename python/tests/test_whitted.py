@@ -31,10 +31,16 @@ def test_info_is_what_whitted_info_prints(glb):
 
 def test_bad_file_raises_whitted_error_naming_it(tmp_path):
     bad = tmp_path / "broken.gltf"
-    bad.write_text('{"asset": {"version": "2.0"}, "accessors": [{"count": 3}]}')
+    # Three positions (36 bytes) declared in a 12-byte buffer.
+    bad.write_text('{"asset": {"version": "2.0"}, "buffers": [{"byteLength": 12, "uri": '
+                   '"data:application/octet-stream;base64,AAAAAAAAAAAAAAAA"}], '
+                   '"bufferViews": [{"buffer": 0, "byteLength": 12}], "accessors": [{"bufferView": 0, '
+                   '"componentType": 5126, "count": 3, "type": "VEC3"}], "meshes": [{"primitives": '
+                   '[{"attributes": {"POSITION": 0}}]}], "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]}')
     with pytest.raises(whitted.Error) as e:
         whitted.load(str(bad))
     assert "broken.gltf" in str(e.value)
+    assert e.value.file == str(bad) and e.value.pointer == "/accessors/0/count"
     with pytest.raises(whitted.Error, match="missing.glb"):
         whitted.load(str(tmp_path / "missing.glb"))
 
