@@ -126,17 +126,21 @@ RayKind parse_kind(const std::string& k) {
     throw py::value_error(fmt::format("kind: '{}' (expected camera, reflection, refraction or shadow)", k));
 }
 
-std::vector<Ray> make_rays(const FloatArray& o, const FloatArray& d, const std::vector<float>& tmin,
-                           const std::vector<float>& tmax) {
-    const size_t n = size_t(o.shape(0));
-    std::vector<Ray> rays(n);
+/// The rays of the query arguments, checked (vectors_arg, per_ray_arg).
+std::vector<Ray> rays_arg(const py::object& origins, const py::object& directions, const py::object& tmin,
+                          const py::object& tmax) {
+    const FloatArray o = vectors_arg(origins, "origins", -1);
+    const py::ssize_t n = o.shape(0);
+    const FloatArray d = vectors_arg(directions, "directions", n);
+    const std::vector<float> t0 = per_ray_arg(tmin, "tmin", n, 0.f), t1 = per_ray_arg(tmax, "tmax", n, kInfinity);
+    std::vector<Ray> rays(static_cast<size_t>(n));
     const float* po = o.data();
     const float* pd = d.data();
-    for (size_t i = 0; i < n; ++i) {
+    for (size_t i = 0; i < rays.size(); ++i) {
         rays[i].org = {po[3 * i], po[3 * i + 1], po[3 * i + 2]};
         rays[i].dir = {pd[3 * i], pd[3 * i + 1], pd[3 * i + 2]};
-        rays[i].tnear = tmin[i];
-        rays[i].tfar = tmax[i];
+        rays[i].tnear = t0[i];
+        rays[i].tfar = t1[i];
     }
     return rays;
 }
@@ -301,11 +305,8 @@ PYBIND11_MODULE(whitted, m) {
             "intersect",
             [](PyScene& s, const py::object& origins, const py::object& directions, const py::object& tmax,
                const py::object& tmin, const std::string& accel, const std::string& kind, int threads) {
-                const FloatArray o = vectors_arg(origins, "origins", -1);
-                const FloatArray d = vectors_arg(directions, "directions", o.shape(0));
-                const py::ssize_t n = o.shape(0);
-                const std::vector<Ray> rays =
-                    make_rays(o, d, per_ray_arg(tmin, "tmin", n, 0.f), per_ray_arg(tmax, "tmax", n, kInfinity));
+                const std::vector<Ray> rays = rays_arg(origins, directions, tmin, tmax);
+                const auto n = py::ssize_t(rays.size());
                 const Accelerator& a = *s.queries_for(accel).accel;
                 const RayKind k = parse_kind(kind);
                 py::array_t<Hit> hits(n);
@@ -325,11 +326,8 @@ PYBIND11_MODULE(whitted, m) {
             "transmittance",
             [](PyScene& s, const py::object& origins, const py::object& directions, const py::object& tmax,
                const py::object& tmin, const std::string& accel, int threads) {
-                const FloatArray o = vectors_arg(origins, "origins", -1);
-                const FloatArray d = vectors_arg(directions, "directions", o.shape(0));
-                const py::ssize_t n = o.shape(0);
-                const std::vector<Ray> rays =
-                    make_rays(o, d, per_ray_arg(tmin, "tmin", n, 0.f), per_ray_arg(tmax, "tmax", n, kInfinity));
+                const std::vector<Ray> rays = rays_arg(origins, directions, tmin, tmax);
+                const auto n = py::ssize_t(rays.size());
                 const Accelerator& a = *s.queries_for(accel).accel;
                 py::array_t<float> t({n, py::ssize_t(3)});
                 float* out = t.mutable_data();
