@@ -26,6 +26,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include "importers/gltf_accessor.h"
@@ -399,6 +400,10 @@ private:
             kMaxJsonDepth)
             fail("", "invalid JSON: arrays/objects nested deeper than {} levels", kMaxJsonDepth);
 
+        // A required extension whitted cannot honour is reported as that, before tinygltf gets to
+        // complain about its consequences (a Draco primitive's accessors have no bufferView).
+        refuse_unsupported_required(reinterpret_cast<const char*>(bytes.data()) + json_offset, json_size);
+
         m_loader.keep_bytes = m_options.load_textures;
         m_loader.max_memory = m_options.max_memory;
         std::error_code ec;
@@ -481,6 +486,26 @@ private:
     }
 
     // ---- extensions ---------------------------------------------------------------------------
+    /// The JSON's top-level extensionsRequired, read on its own (the rest is skipped, not stored):
+    /// any that whitted refuses is the error. JSON that does not parse is left to tinygltf.
+    void refuse_unsupported_required(const char* json, size_t size) const {
+        const nlohmann::json::parser_callback_t keep_required = [](int depth, nlohmann::json::parse_event_t event,
+                                                                  nlohmann::json& parsed) {
+            return !(depth == 1 && event == nlohmann::json::parse_event_t::key && parsed != "extensionsRequired");
+        };
+        const nlohmann::json doc = nlohmann::json::parse(json, json + size, keep_required, false);
+        if (!doc.is_object() || !doc.contains("extensionsRequired") || !doc["extensionsRequired"].is_array()) return;
+        const nlohmann::json& required = doc["extensionsRequired"];
+        for (size_t i = 0; i < required.size(); ++i) {
+            if (!required[i].is_string()) continue;
+            const std::string name = required[i].get<std::string>();
+            const ExtensionPolicy policy = extension_policy(name);
+            if (policy.support != ExtensionSupport::Supported && policy.refuse_if_required)
+                fail(fmt::format("/extensionsRequired/{}", i), "required extension {} is not supported by whitted ({})",
+                     name, policy.known ? policy.note : "unknown extension");
+        }
+    }
+
     void classify_extensions() {
         std::vector<std::string> names = m_model.extensionsUsed;
         for (const std::string& r : m_model.extensionsRequired)

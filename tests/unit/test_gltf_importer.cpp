@@ -801,6 +801,56 @@ TEST(GltfHandMade, RequiredExtensions) {
     EXPECT_EQ(warnings_containing(s, "extension EXT_foo ignored"), 1u);
 }
 
+// Compressed files name the extension they need, not its consequences: a Draco primitive's
+// accessors have no bufferView (tinygltf said "accessor[1] invalid bufferView"), a meshopt
+// file's fallback buffer has no data; in a .gltf and in a GLB's JSON chunk.
+TEST(GltfHandMade, RequiredCompressionIsNamedBeforeItsConsequences) {
+    const std::string draco_json = R"({"asset": {"version": "2.0"},
+      "extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"],
+      "buffers": [{"byteLength": 4, "uri": "data:application/octet-stream;base64,AAAAAA=="}],
+      "bufferViews": [{"buffer": 0, "byteLength": 4}],
+      "accessors": [{"componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                    {"componentType": 5123, "count": 3, "type": "SCALAR"}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "extensions":
+        {"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}}}]}],
+      "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]})";
+    const std::string meshopt_json = R"({"asset": {"version": "2.0"},
+      "extensionsUsed": ["EXT_meshopt_compression"], "extensionsRequired": ["EXT_meshopt_compression"],
+      "buffers": [{"byteLength": 36, "extensions": {"EXT_meshopt_compression": {"fallback": true}}},
+                  {"byteLength": 8, "uri": "data:application/octet-stream;base64,AAAAAAAAAAA="}],
+      "bufferViews": [{"buffer": 0, "byteLength": 36, "byteStride": 12, "extensions": {"EXT_meshopt_compression":
+        {"buffer": 1, "byteLength": 8, "byteStride": 12, "count": 3, "mode": "ATTRIBUTES"}}}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+      "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]})";
+    for (const auto& [name, json, ext] : {std::tuple{"draco_req.gltf", draco_json, "KHR_draco_mesh_compression"},
+                                          std::tuple{"meshopt_req.gltf", meshopt_json, "EXT_meshopt_compression"}}) {
+        const std::string path = write_file(name, json);
+        const std::string err = error_text([&] { load_scene(path); });
+        EXPECT_NE(err.find(path + ": /extensionsRequired/0: required extension " + std::string(ext) +
+                           " is not supported by whitted"),
+                  std::string::npos)
+            << err;
+        // The same JSON as a GLB's JSON chunk (padded with spaces to 4 bytes).
+        std::string chunk = json;
+        while (chunk.size() % 4) chunk += ' ';
+        std::vector<uint8_t> glb;
+        auto u32 = [&](uint32_t v) {
+            for (int i = 0; i < 4; ++i) glb.push_back(uint8_t(v >> (8 * i)));
+        };
+        u32(0x46546C67);
+        u32(2);
+        u32(uint32_t(20 + chunk.size()));
+        u32(uint32_t(chunk.size()));
+        u32(0x4E4F534A);
+        glb.insert(glb.end(), chunk.begin(), chunk.end());
+        const std::string glb_path = write_file(std::string(name) + ".glb", glb);
+        const std::string glb_err = error_text([&] { load_scene(glb_path); });
+        EXPECT_NE(glb_err.find("/extensionsRequired/0: required extension " + std::string(ext)), std::string::npos)
+            << glb_err;
+    }
+}
+
 TEST(GltfHandMade, ByteStrideOutOfRange) {
     // tinygltf refuses it while parsing (whitted's own check covers views tinygltf lets through).
     const std::string path = write_gltf("stride300.gltf",
