@@ -47,7 +47,7 @@ constexpr std::array kTable = {
     Entry{"KHR_xmp_json_ld", I, false, "metadata not read"},
     Entry{"KHR_animation_pointer", I, false, "animations are not played"},
     Entry{"KHR_texture_basisu", I, true, "KTX2/Basis images not decoded; the core texture source is used when present"},
-    Entry{"EXT_texture_webp", I, true, "WebP images not decoded; the core texture source is used when present"},
+    Entry{"EXT_texture_webp", S, false, "WebP images decoded (libwebp), preferred over the core source"},
     Entry{"EXT_texture_avif", I, true, "AVIF images not decoded; the core texture source is used when present"},
     Entry{"MSFT_texture_dds", I, true, "DDS images not decoded; the core texture source is used when present"},
     Entry{"KHR_draco_mesh_compression", I, true, "not decoded; the uncompressed fallback attributes are used"},

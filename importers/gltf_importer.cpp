@@ -559,21 +559,25 @@ private:
         if (auto it = m_texture_map.find(key); it != m_texture_map.end()) return it->second;
         const tinygltf::Texture& t = m_model.textures[size_t(gltf_texture)];
         int32_t result = -1;
-        if (t.source < 0) {
+        // EXT_texture_webp's image is the preferred one; the core source is its fallback.
+        int source = t.source;
+        if (const auto webp = t.extensions.find("EXT_texture_webp"); webp != t.extensions.end())
+            if (const tinygltf::Value* v = find_member(&webp->second, "source"); v != nullptr) as_int(v, source);
+        if (source < 0) {
             std::string exts;
             for (const auto& [name, v] : t.extensions) exts += (exts.empty() ? "" : ", ") + name;
             m_warnings.add("texture-no-source",
-                           fmt::format("/textures/{}: no image in a core format (PNG/JPEG){}: texture not used",
+                           fmt::format("/textures/{}: no image whitted decodes (PNG, JPEG, WebP){}: texture not used",
                                        gltf_texture, exts.empty() ? "" : " - only " + exts));
         } else {
             Texture tex;
-            const tinygltf::Image& img = m_model.images[size_t(t.source)];
+            const tinygltf::Image& img = m_model.images[size_t(source)];
             tex.name = !t.name.empty()     ? t.name
                        : !img.name.empty() ? img.name
                        : !img.uri.empty()  ? img.uri
-                                           : fmt::format("image {}", t.source);
+                                           : fmt::format("image {}", source);
             tex.srgb = srgb;
-            tex.image = t.source;
+            tex.image = source;
             if (t.sampler >= 0) {
                 const tinygltf::Sampler& s = m_model.samplers[size_t(t.sampler)];
                 auto wrap = [](int w) {

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <webp/decode.h>
 
 // stb_image compiled here (Debian's libstb-dev header), not the copy inside the tinygltf shared
 // library: this one is built with the project's flags, so sanitizer and fuzzing builds instrument
@@ -39,8 +40,14 @@ namespace whitted {
 
 static_assert(STBI_MAX_DIMENSIONS == kMaxImageSide, "stb_image's limit is whitted's");
 
+bool is_webp(const uint8_t* p, size_t n) {
+    return p != nullptr && n >= 12 && std::memcmp(p, "RIFF", 4) == 0 && std::memcmp(p + 8, "WEBP", 4) == 0;
+}
+
 bool image_size_from_header(const uint8_t* p, size_t n, int& w, int& h) {
     if (p == nullptr) return false;
+    // WebP (EXT_texture_webp): libwebp reads the size from the VP8/VP8L/VP8X header alone.
+    if (is_webp(p, n)) return WebPGetInfo(p, n, &w, &h) != 0;
     auto be16 = [&](size_t i) { return (uint32_t(p[i]) << 8) | p[i + 1]; };
     auto be32 = [&](size_t i) { return (be16(i) << 16) | be16(i + 2); };
     // PNG: the signature, then IHDR as the first chunk (PNG spec 11.2.2).
@@ -125,11 +132,21 @@ MipLevel decode_image_rgba8(const uint8_t* bytes, size_t size, size_t max_memory
     // Dimensions from the header first: stb_image allocates whatever the header claims.
     int header_w = 0, header_h = 0;
     if (!image_size_from_header(bytes, size, header_w, header_h))
-        throw Error(loc, fmt::format("cannot decode image '{}': not a PNG or JPEG image (or its header is cut "
-                                     "short): glTF core images are PNG or JPEG",
+        throw Error(loc, fmt::format("cannot decode image '{}': not a PNG, JPEG or WebP image (or its header is cut "
+                                     "short): glTF core images are PNG or JPEG, EXT_texture_webp adds WebP",
                                      label));
     if (const std::string refused = check_image_size(header_w, header_h, max_memory); !refused.empty())
         throw Error(loc, fmt::format("image '{}' refused: {}", label, refused));
+    if (is_webp(bytes, size)) {
+        // RGBA8 straight from libwebp (lossy or lossless; alpha 255 where the file has none).
+        MipLevel level;
+        level.width = header_w;
+        level.height = header_h;
+        level.texels.resize(size_t(header_w) * size_t(header_h) * 4);
+        if (!WebPDecodeRGBAInto(bytes, size, level.texels.data(), level.texels.size(), header_w * 4))
+            throw Error(loc, fmt::format("cannot decode image '{}': corrupt WebP data", label));
+        return level;
+    }
     if (is_png(bytes, size))
         if (const std::string refused = check_png_chunks(bytes, size); !refused.empty())
             throw Error(loc, fmt::format("cannot decode image '{}': {}", label, refused));

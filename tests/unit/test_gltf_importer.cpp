@@ -10,6 +10,7 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <webp/encode.h>
 
 #include "tests/support/test_importer_util.h"
 
@@ -1020,6 +1021,82 @@ TEST(GltfHandMade, PngChannelExpansionAndSixteenBit) {
     EXPECT_EQ(t.levels.size(), 1u);
     EXPECT_EQ(t.wrap_s, WrapMode::MirroredRepeat);
     EXPECT_EQ(t.levels.at(0).texels, (std::vector<uint8_t>{255, 255, 255, 255, 128, 128, 128, 255}));
+}
+
+// EXT_texture_webp: the WebP image is preferred over the core (PNG) fallback; lossless decodes
+// exactly, lossy within its quantisation; a corrupt one is a located error; a texture that offers
+// only KHR_texture_basisu is dropped with one warning naming it.
+TEST(GltfHandMade, WebpTexturesDecodeAndArePreferred) {
+    const int w = 4, h = 2;
+    std::vector<uint8_t> rgba(size_t(w * h * 4));
+    for (size_t i = 0; i < rgba.size(); ++i) rgba[i] = uint8_t((i * 37 + 11) % 256);
+    for (size_t i = 3; i < rgba.size(); i += 4) rgba[i] = 255;
+    uint8_t* lossless = nullptr;
+    const size_t lossless_size = WebPEncodeLosslessRGBA(rgba.data(), w, h, w * 4, &lossless);
+    // Lossy: a smooth 16x16 gradient (lossy WebP subsamples chroma, so not the noisy image).
+    const int lw = 16;
+    std::vector<uint8_t> smooth(size_t(lw * lw * 4));
+    for (int y = 0; y < lw; ++y)
+        for (int x = 0; x < lw; ++x) {
+            uint8_t* p = &smooth[size_t((y * lw + x) * 4)];
+            p[0] = uint8_t(40 + 10 * x);
+            p[1] = uint8_t(200 - 8 * y);
+            p[2] = uint8_t(100 + 4 * (x + y));
+            p[3] = 255;
+        }
+    uint8_t* lossy = nullptr;
+    const size_t lossy_size = WebPEncodeRGBA(smooth.data(), lw, lw, lw * 4, 95.f, &lossy);
+    ASSERT_GT(lossless_size, 0u);
+    ASSERT_GT(lossy_size, 0u);
+    const std::vector<uint8_t> webp_exact(lossless, lossless + lossless_size), webp_lossy(lossy, lossy + lossy_size);
+    WebPFree(lossless);
+    WebPFree(lossy);
+    const std::vector<uint8_t> fallback = make_png(1, 1, 8, 6, {1, 2, 3, 255});  // must not be used
+    // tinygltf takes no image/webp data URIs: an external file, as real files have, or octet-stream.
+    auto scene_with = [&](const std::string& name, const std::vector<uint8_t>& webp) {
+        const std::string uri = name + ".webp";
+        write_file(uri, webp);
+        std::string json =
+            edit(kQuadJson, R"("attributes": {"POSITION": 0})", R"("attributes": {"POSITION": 0}, "material": 0)");
+        json = edit(json, R"("scene": 0)",
+                    R"("scene": 0, "extensionsUsed": ["EXT_texture_webp"],
+            "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+            "textures": [{"source": 0, "extensions": {"EXT_texture_webp": {"source": 1}}}],
+            "images": [{"uri": ")" + data_uri(fallback, "image/png") + R"("}, {"uri": ")" + uri +
+                        R"(", "mimeType": "image/webp"}])");
+        return write_gltf(name, json, quad_bin());
+    };
+    const Scene exact = load_scene(scene_with("webp_lossless.gltf", webp_exact));
+    ASSERT_EQ(exact.textures.size(), 1u);
+    EXPECT_EQ(exact.textures[0].image, 1);
+    ASSERT_FALSE(exact.textures[0].levels.empty());
+    EXPECT_EQ(exact.textures[0].levels[0].width, w);
+    EXPECT_EQ(exact.textures[0].levels[0].texels, rgba);
+    ASSERT_EQ(exact.extensions.size(), 1u);
+    EXPECT_EQ(exact.extensions[0].support, ExtensionSupport::Supported);
+    const Scene near = load_scene(scene_with("webp_lossy.gltf", webp_lossy));
+    const std::vector<uint8_t>& got = near.textures.at(0).levels.at(0).texels;
+    ASSERT_EQ(got.size(), smooth.size());
+    int worst = 0;
+    for (size_t i = 0; i < got.size(); ++i) worst = std::max(worst, std::abs(int(got[i]) - int(smooth[i])));
+    EXPECT_LE(worst, 12);  // quality 95 on a smooth image
+
+    std::vector<uint8_t> broken = webp_exact;
+    for (size_t i = 20; i < broken.size(); ++i) broken[i] = uint8_t(broken[i] ^ 0x5A);
+    const std::string err = error_text([&] { load_scene(scene_with("webp_broken.gltf", broken)); });
+    EXPECT_NE(err.find("/images/1: cannot decode image"), std::string::npos) << err;
+
+    std::string ktx = edit(kQuadJson, R"("attributes": {"POSITION": 0})",
+                           R"("attributes": {"POSITION": 0}, "material": 0)");
+    ktx = edit(ktx, R"("scene": 0)", R"("scene": 0, "extensionsUsed": ["KHR_texture_basisu"],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+        "textures": [{"extensions": {"KHR_texture_basisu": {"source": 0}}}],
+        "images": [{"uri": "tex.ktx2", "mimeType": "image/ktx2"}])");
+    write_file("tex.ktx2", std::string("\xABKTX 20\xBB\r\n\x1A\n"));
+    const Scene k = load_scene(write_gltf("ktx_only.gltf", ktx, quad_bin()));
+    EXPECT_TRUE(k.textures.empty());
+    EXPECT_EQ(warnings_containing(k, "/textures/0: no image whitted decodes (PNG, JPEG, WebP) - only KHR_texture_basisu"),
+              1u);
 }
 
 TEST(GltfHandMade, UndecodableImageIsAnError) {
