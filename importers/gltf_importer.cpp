@@ -32,6 +32,7 @@
 #include "importers/gltf_accessor.h"
 #include "importers/gltf_extensions.h"
 #include "importers/gltf_json.h"
+#include "importers/gltf_meshopt.h"
 #include "importers/gltf_validation.h"
 #include "importers/image_decode.h"
 #include "importers/mesh_normals.h"
@@ -209,6 +210,7 @@ std::optional<std::filesystem::path> resolve_uri(const std::string& lookup, UriP
 /// FsCallbacks::FileExists under the policy: regular files only (no devices, FIFOs, folders).
 bool policy_file_exists(const std::string& lookup, void* user) {
     auto& policy = *static_cast<UriPolicy*>(user);
+    if (meshopt_fallback_size(lookup)) return true;
     const std::optional<std::filesystem::path> file = resolve_uri(lookup, policy);
     if (!file) return false;
     std::error_code ec;
@@ -225,6 +227,17 @@ bool policy_file_exists(const std::string& lookup, void* user) {
 /// FsCallbacks::ReadWholeFile under the policy, refusing files larger than the memory limit.
 bool policy_read_file(std::vector<unsigned char>* out, std::string* err, const std::string& lookup, void* user) {
     auto& policy = *static_cast<UriPolicy*>(user);
+    if (const std::optional<size_t> fallback = meshopt_fallback_size(lookup)) {  // zeros, decoded into later
+        if (*fallback > policy.max_bytes) {
+            if (policy.refused.empty())
+                policy.refused = fmt::format("an EXT_meshopt_compression buffer of {} bytes exceeds the memory limit "
+                                             "of {} bytes", *fallback, policy.max_bytes);
+            if (err) *err += "over the memory limit";
+            return false;
+        }
+        out->assign(*fallback, 0);
+        return true;
+    }
     const std::optional<std::filesystem::path> file = resolve_uri(lookup, policy);
     if (!file) {
         if (err) *err += "refused by the URI policy";
@@ -404,6 +417,11 @@ private:
         // complain about its consequences (a Draco primitive's accessors have no bufferView).
         refuse_unsupported_required(reinterpret_cast<const char*>(bytes.data()) + json_offset, json_size);
 
+        // EXT_meshopt_compression's fallback buffers carry no data: they get a uri the file
+        // callbacks serve as zeros, and the streams are decoded into them after parsing.
+        const std::optional<std::vector<uint8_t>> rewritten = with_fallback_uris(bytes, binary, json_offset, json_size);
+        const std::span<const uint8_t> file = rewritten ? std::span<const uint8_t>(*rewritten) : bytes;
+
         m_loader.keep_bytes = m_options.load_textures;
         m_loader.max_memory = m_options.max_memory;
         std::error_code ec;
@@ -421,11 +439,11 @@ private:
         bool ok = false;
         try {
             if (binary)
-                ok = parser.LoadBinaryFromMemory(&m_model, &err, &warn, bytes.data(), unsigned(bytes.size()),
+                ok = parser.LoadBinaryFromMemory(&m_model, &err, &warn, file.data(), unsigned(file.size()),
                                                  m_base_dir);
             else
-                ok = parser.LoadASCIIFromString(&m_model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
-                                                unsigned(bytes.size()), m_base_dir);
+                ok = parser.LoadASCIIFromString(&m_model, &err, &warn, reinterpret_cast<const char*>(file.data()),
+                                                unsigned(file.size()), m_base_dir);
         } catch (const std::bad_alloc&) {
             fail("", "out of memory while parsing");
         } catch (const std::exception& e) {
@@ -459,6 +477,7 @@ private:
                 fail("", "invalid JSON: {}", msg);
             fail("", "glTF parse error: {}", msg);
         }
+        decode_meshopt_views(m_model, m_path);
         // tinygltf reports an image it could not find as a warning; whitted treats it as an error
         // (check_images_present), so only keep the other warnings.
         size_t start = 0;

@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 #include <webp/encode.h>
+#include <meshoptimizer.h>
+#include <fmt/format.h>
 
 #include "tests/support/test_importer_util.h"
 
@@ -803,8 +805,8 @@ TEST(GltfHandMade, RequiredExtensions) {
 }
 
 // Compressed files name the extension they need, not its consequences: a Draco primitive's
-// accessors have no bufferView (tinygltf said "accessor[1] invalid bufferView"), a meshopt
-// file's fallback buffer has no data; in a .gltf and in a GLB's JSON chunk.
+// accessors have no bufferView (tinygltf said "accessor[1] invalid bufferView"); in a .gltf and in
+// a GLB's JSON chunk.
 TEST(GltfHandMade, RequiredCompressionIsNamedBeforeItsConsequences) {
     const std::string draco_json = R"({"asset": {"version": "2.0"},
       "extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"],
@@ -815,17 +817,7 @@ TEST(GltfHandMade, RequiredCompressionIsNamedBeforeItsConsequences) {
       "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "extensions":
         {"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}}}]}],
       "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]})";
-    const std::string meshopt_json = R"({"asset": {"version": "2.0"},
-      "extensionsUsed": ["EXT_meshopt_compression"], "extensionsRequired": ["EXT_meshopt_compression"],
-      "buffers": [{"byteLength": 36, "extensions": {"EXT_meshopt_compression": {"fallback": true}}},
-                  {"byteLength": 8, "uri": "data:application/octet-stream;base64,AAAAAAAAAAA="}],
-      "bufferViews": [{"buffer": 0, "byteLength": 36, "byteStride": 12, "extensions": {"EXT_meshopt_compression":
-        {"buffer": 1, "byteLength": 8, "byteStride": 12, "count": 3, "mode": "ATTRIBUTES"}}}],
-      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}],
-      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
-      "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]})";
-    for (const auto& [name, json, ext] : {std::tuple{"draco_req.gltf", draco_json, "KHR_draco_mesh_compression"},
-                                          std::tuple{"meshopt_req.gltf", meshopt_json, "EXT_meshopt_compression"}}) {
+    for (const auto& [name, json, ext] : {std::tuple{"draco_req.gltf", draco_json, "KHR_draco_mesh_compression"}}) {
         const std::string path = write_file(name, json);
         const std::string err = error_text([&] { load_scene(path); });
         EXPECT_NE(err.find(path + ": /extensionsRequired/0: required extension " + std::string(ext) +
@@ -850,6 +842,85 @@ TEST(GltfHandMade, RequiredCompressionIsNamedBeforeItsConsequences) {
         EXPECT_NE(glb_err.find("/extensionsRequired/0: required extension " + std::string(ext)), std::string::npos)
             << glb_err;
     }
+}
+
+// EXT_meshopt_compression: a quad whose positions (ATTRIBUTES, EXPONENTIAL filter) and indices
+// (TRIANGLES) are meshopt streams in buffer 1, decoded into fallback buffer 0 (no uri); as .gltf
+// and as GLB; a corrupt stream and a hostile count are located errors.
+TEST(GltfHandMade, MeshoptStreamsDecodeIntoTheFallbackBuffer) {
+    const std::vector<float> positions{0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0.25f};
+    const std::vector<unsigned> indices{0, 1, 2, 0, 2, 3};
+    std::vector<uint8_t> exp_encoded(positions.size() * 4);
+    meshopt_encodeFilterExp(exp_encoded.data(), 4, 12, 24, positions.data());
+    std::vector<uint8_t> vstream(meshopt_encodeVertexBufferBound(4, 12));
+    vstream.resize(meshopt_encodeVertexBuffer(vstream.data(), vstream.size(), exp_encoded.data(), 4, 12));
+    std::vector<uint8_t> istream(meshopt_encodeIndexBufferBound(6, 4));
+    istream.resize(meshopt_encodeIndexBuffer(istream.data(), istream.size(), indices.data(), 6));
+    std::vector<uint8_t> compressed = vstream;
+    while (compressed.size() % 4) compressed.push_back(0);
+    const size_t ioffset = compressed.size();
+    compressed.insert(compressed.end(), istream.begin(), istream.end());
+    // In a .gltf: buffer 0 the fallback, buffer 1 the streams (a data URI). In a GLB, as gltfpack
+    // writes them: buffer 0 the BIN chunk with the streams, buffer 1 the fallback.
+    auto json_with = [&](size_t count, const std::vector<uint8_t>& stream, bool glb) {
+        const std::string fallback = R"({"byteLength": 60, "extensions": {"EXT_meshopt_compression": {"fallback": true}}})";
+        const std::string data = glb ? fmt::format(R"({{"byteLength": {}}})", stream.size())
+                                     : fmt::format(R"({{"byteLength": {}, "uri": "{}"}})", stream.size(), data_uri(stream));
+        const int target = glb ? 1 : 0, source = glb ? 0 : 1;
+        return fmt::format(R"({{"asset": {{"version": "2.0"}},
+      "extensionsUsed": ["EXT_meshopt_compression"], "extensionsRequired": ["EXT_meshopt_compression"],
+      "buffers": [{}, {}],
+      "bufferViews": [{{"buffer": {}, "byteLength": 48, "byteStride": 12, "extensions": {{"EXT_meshopt_compression":
+                         {{"buffer": {}, "byteLength": {}, "byteStride": 12, "count": {}, "mode": "ATTRIBUTES", "filter": "EXPONENTIAL"}}}}}},
+                      {{"buffer": {}, "byteOffset": 48, "byteLength": 12, "extensions": {{"EXT_meshopt_compression":
+                         {{"buffer": {}, "byteOffset": {}, "byteLength": {}, "byteStride": 2, "count": 6, "mode": "TRIANGLES"}}}}}}],
+      "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0.25]}},
+                    {{"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}}],
+      "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1}}]}}],
+      "nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}]}})",
+                           glb ? data : fallback, glb ? fallback : data, target, source, vstream.size(), count, target,
+                           source, ioffset, istream.size());
+    };
+    auto check = [&](const Scene& s) {
+        ASSERT_EQ(s.meshes.size(), 1u);
+        const Mesh& m = s.meshes[0];
+        ASSERT_EQ(m.positions.size(), 4u);
+        for (size_t v = 0; v < 4; ++v)
+            for (int c = 0; c < 3; ++c) EXPECT_NEAR(m.positions[v][c], positions[3 * v + size_t(c)], 1e-6f);
+        ASSERT_EQ(m.indices.size(), 6u);
+        for (size_t k = 0; k < 6; ++k) EXPECT_EQ(m.indices[k], indices[k]);
+    };
+    check(load_scene(write_file("meshopt.gltf", json_with(4, compressed, false))));
+    // The same as a GLB (its JSON chunk rewritten; the chunk after it kept).
+    std::string chunk = json_with(4, compressed, true);
+    while (chunk.size() % 4) chunk += ' ';
+    std::vector<uint8_t> bin = compressed;
+    while (bin.size() % 4) bin.push_back(0);
+    std::vector<uint8_t> glb;
+    auto u32 = [&](uint32_t v) {
+        for (int i = 0; i < 4; ++i) glb.push_back(uint8_t(v >> (8 * i)));
+    };
+    u32(0x46546C67);
+    u32(2);
+    u32(uint32_t(12 + 8 + chunk.size() + 8 + bin.size()));
+    u32(uint32_t(chunk.size()));
+    u32(0x4E4F534A);
+    glb.insert(glb.end(), chunk.begin(), chunk.end());
+    u32(uint32_t(bin.size()));
+    u32(0x004E4942);
+    glb.insert(glb.end(), bin.begin(), bin.end());
+    check(load_scene(write_file("meshopt.glb", glb)));
+
+    std::vector<uint8_t> corrupt = compressed;
+    for (size_t i = 1; i < vstream.size(); ++i) corrupt[i] = 0xFF;
+    const std::string err = error_text([&] { load_scene(write_file("meshopt_corrupt.gltf", json_with(4, corrupt, false))); });
+    EXPECT_NE(err.find("/bufferViews/0/extensions/EXT_meshopt_compression: corrupt ATTRIBUTES stream"),
+              std::string::npos)
+        << err;
+    const std::string huge = error_text([&] { load_scene(write_file("meshopt_huge.gltf", json_with(1000000000, compressed, false))); });
+    EXPECT_NE(huge.find("/bufferViews/0/extensions/EXT_meshopt_compression: count 1000000000 x byteStride 12"),
+              std::string::npos)
+        << huge;
 }
 
 TEST(GltfHandMade, ByteStrideOutOfRange) {

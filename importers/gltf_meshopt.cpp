@@ -1,0 +1,156 @@
+#include "importers/gltf_meshopt.h"
+
+#include <cstring>
+
+#include <fmt/format.h>
+#include <meshoptimizer.h>
+#include <nlohmann/json.hpp>
+
+#include "importers/gltf_json.h"
+#include "renderer/core/error.h"
+
+namespace whitted {
+
+namespace {
+
+constexpr const char* kExt = "EXT_meshopt_compression";
+constexpr const char* kMarker = "whitted-meshopt-fallback-";
+
+[[noreturn]] void fail(const std::string& path, const std::string& pointer, const std::string& message) {
+    FileLoc loc;
+    loc.file = path;
+    loc.pointer = pointer;
+    throw Error(loc, message);
+}
+
+/// A non-negative integer member of an extension object; `fallback` when absent.
+size_t member(const tinygltf::Value& ext, const char* key, size_t fallback, const std::string& path,
+              const std::string& ptr) {
+    const tinygltf::Value* v = gltf::find_member(&ext, key);
+    if (v == nullptr) return fallback;
+    int i = -1;
+    if (!gltf::as_int(v, i) || i < 0) fail(path, ptr + "/" + key, fmt::format("{} must be a non-negative integer", key));
+    return size_t(i);
+}
+
+std::string text_member(const tinygltf::Value& ext, const char* key, const char* fallback) {
+    const tinygltf::Value* v = gltf::find_member(&ext, key);
+    return v != nullptr && v->IsString() ? v->Get<std::string>() : std::string(fallback);
+}
+
+}  // namespace
+
+std::string meshopt_fallback_uri(size_t buffer, size_t bytes) { return fmt::format("{}{}-{}", kMarker, buffer, bytes); }
+
+std::optional<size_t> meshopt_fallback_size(const std::string& lookup) {
+    const size_t at = lookup.rfind(kMarker);
+    if (at == std::string::npos) return std::nullopt;
+    const std::string rest = lookup.substr(at + std::strlen(kMarker));
+    const size_t dash = rest.find('-');
+    if (dash == std::string::npos) return std::nullopt;
+    try {
+        return size_t(std::stoull(rest.substr(dash + 1)));
+    } catch (const std::exception&) {
+        return std::nullopt;
+    }
+}
+
+std::optional<std::vector<uint8_t>> with_fallback_uris(std::span<const uint8_t> file, bool binary, size_t json_offset,
+                                                       size_t json_size) {
+    const char* json = reinterpret_cast<const char*>(file.data()) + json_offset;
+    if (std::string_view(json, json_size).find(kExt) == std::string_view::npos) return std::nullopt;
+    nlohmann::json doc = nlohmann::json::parse(json, json + json_size, nullptr, false);
+    if (!doc.is_object() || !doc.contains("buffers") || !doc["buffers"].is_array()) return std::nullopt;
+    bool changed = false;
+    nlohmann::json& buffers = doc["buffers"];
+    for (size_t i = 0; i < buffers.size(); ++i) {
+        nlohmann::json& b = buffers[i];
+        if (!b.is_object() || b.contains("uri") || !b.contains("extensions") || !b["extensions"].is_object() ||
+            !b["extensions"].contains(kExt))
+            continue;
+        if (binary && i == 0) continue;  // a GLB's first buffer without a uri is its BIN chunk
+        const nlohmann::json& length = b.contains("byteLength") ? b["byteLength"] : nlohmann::json();
+        if (!length.is_number_unsigned()) continue;  // tinygltf reports it
+        b["uri"] = meshopt_fallback_uri(i, length.get<size_t>());
+        changed = true;
+    }
+    if (!changed) return std::nullopt;
+    std::string text = doc.dump();
+    std::vector<uint8_t> out;
+    if (!binary) return std::vector<uint8_t>(text.begin(), text.end());
+    while (text.size() % 4) text += ' ';
+    auto u32 = [&](uint32_t v) {
+        for (int k = 0; k < 4; ++k) out.push_back(uint8_t(v >> (8 * k)));
+    };
+    const size_t rest = json_offset + json_size;  // the chunks after JSON, unchanged
+    u32(0x46546C67);
+    u32(2);
+    u32(uint32_t(12 + 8 + text.size() + (file.size() - rest)));
+    u32(uint32_t(text.size()));
+    u32(0x4E4F534A);
+    out.insert(out.end(), text.begin(), text.end());
+    out.insert(out.end(), file.begin() + std::ptrdiff_t(rest), file.end());
+    return out;
+}
+
+void decode_meshopt_views(tinygltf::Model& model, const std::string& path) {
+    for (size_t i = 0; i < model.bufferViews.size(); ++i) {
+        const tinygltf::BufferView& view = model.bufferViews[i];
+        const auto found = view.extensions.find(kExt);
+        if (found == view.extensions.end()) continue;
+        const tinygltf::Value& ext = found->second;
+        const std::string ptr = fmt::format("/bufferViews/{}/extensions/{}", i, kExt);
+        if (view.buffer < 0 || size_t(view.buffer) >= model.buffers.size())
+            fail(path, fmt::format("/bufferViews/{}/buffer", i), "buffer out of range");
+        tinygltf::Buffer& target = model.buffers[size_t(view.buffer)];
+        if (target.uri.rfind(kMarker, 0) != 0) continue;  // the buffer has data of its own: use it
+        const size_t source = member(ext, "buffer", size_t(-1), path, ptr);
+        if (source >= model.buffers.size()) fail(path, ptr + "/buffer", "source buffer out of range");
+        const std::vector<unsigned char>& src = model.buffers[source].data;
+        const size_t offset = member(ext, "byteOffset", 0, path, ptr);
+        const size_t length = member(ext, "byteLength", size_t(-1), path, ptr);
+        const size_t stride = member(ext, "byteStride", 0, path, ptr);
+        const size_t count = member(ext, "count", size_t(-1), path, ptr);
+        const std::string mode = text_member(ext, "mode", "");
+        const std::string filter = text_member(ext, "filter", "NONE");
+        if (length == size_t(-1) || count == size_t(-1)) fail(path, ptr, "byteLength and count are required");
+        if (offset > src.size() || length > src.size() - offset)
+            fail(path, ptr, fmt::format("bytes {}..{} are outside source buffer {} ({} bytes)", offset, offset + length,
+                                        source, src.size()));
+        // The decoded bytes must fit the view and the view its buffer, before anything is written.
+        if (stride == 0 || count > (size_t(1) << 32) / stride)
+            fail(path, ptr, fmt::format("count {} x byteStride {} is not a valid size", count, stride));
+        const size_t decoded = count * stride;
+        if (decoded > view.byteLength)
+            fail(path, ptr, fmt::format("count {} x byteStride {} = {} bytes exceeds the bufferView's byteLength {}",
+                                        count, stride, decoded, view.byteLength));
+        if (view.byteOffset > target.data.size() || view.byteLength > target.data.size() - view.byteOffset)
+            fail(path, fmt::format("/bufferViews/{}", i), "the bufferView is outside its buffer");
+        unsigned char* dest = target.data.data() + view.byteOffset;
+        const unsigned char* in = src.data() + offset;
+        int rc = 0;
+        if (mode == "ATTRIBUTES") {
+            if (stride % 4 != 0 || stride > 256)
+                fail(path, ptr + "/byteStride", fmt::format("ATTRIBUTES byteStride {} is not a multiple of 4 up to 256", stride));
+            rc = meshopt_decodeVertexBuffer(dest, count, stride, in, length);
+        } else if (mode == "TRIANGLES" || mode == "INDICES") {
+            if (stride != 2 && stride != 4)
+                fail(path, ptr + "/byteStride", fmt::format("{} byteStride {} is not 2 or 4", mode, stride));
+            if (mode == "TRIANGLES" && count % 3 != 0)
+                fail(path, ptr + "/count", fmt::format("TRIANGLES count {} is not a multiple of 3", count));
+            rc = mode == "TRIANGLES" ? meshopt_decodeIndexBuffer(dest, count, stride, in, length)
+                                     : meshopt_decodeIndexSequence(dest, count, stride, in, length);
+        } else {
+            fail(path, ptr + "/mode", fmt::format("mode '{}' (expected ATTRIBUTES, TRIANGLES or INDICES)", mode));
+        }
+        if (rc != 0) fail(path, ptr, fmt::format("corrupt {} stream (meshopt error {})", mode, rc));
+        if (filter == "NONE") continue;
+        if (mode != "ATTRIBUTES") fail(path, ptr + "/filter", fmt::format("filter {} needs mode ATTRIBUTES", filter));
+        if (filter == "OCTAHEDRAL" && (stride == 4 || stride == 8)) meshopt_decodeFilterOct(dest, count, stride);
+        else if (filter == "QUATERNION" && stride == 8) meshopt_decodeFilterQuat(dest, count, stride);
+        else if (filter == "EXPONENTIAL") meshopt_decodeFilterExp(dest, count, stride);
+        else fail(path, ptr + "/filter", fmt::format("filter '{}' with byteStride {} is not valid", filter, stride));
+    }
+}
+
+}  // namespace whitted
