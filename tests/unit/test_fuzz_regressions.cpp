@@ -171,7 +171,7 @@ TEST(HostileInput, ImageDimensionsAreCheckedFromTheHeaderBeforeDecoding) {
     EXPECT_NE(chunk.find("truncated PNG: chunk 'IDAT'"), std::string::npos) << chunk;
     const std::vector<uint8_t> gif = {'G', 'I', 'F', '8', '9', 'a', 1, 0, 1, 0, 0, 0, 0};
     const std::string other = decode(gif);
-    EXPECT_NE(other.find("not a PNG or JPEG"), std::string::npos) << other;
+    EXPECT_NE(other.find("not a PNG, JPEG or WebP image"), std::string::npos) << other;
 }
 
 TEST(HostileInput, DeeplyNestedJsonIsRefusedBeforeParsing) {
