@@ -198,19 +198,6 @@ std::string with_spec_options(std::string spec, std::initializer_list<std::pair<
     return spec;
 }
 
-/// Under MPI the ranks agree on the set-up: when any failed, every rank returns false; the
-/// error is printed once (rank 0's, or else each failed rank's, prefixed with its number).
-bool setup_agreed(const MpiSession& mpi, const std::string& error) {
-    if (mpi.all(error.empty())) return true;
-    const bool root_failed = mpi.from_root(mpi.rank() == 0 && !error.empty());
-    if (!error.empty() && (mpi.rank() == 0 || !root_failed)) {
-        if (mpi.rank() == 0) std::fprintf(stderr, "whitted: error: %s\n", error.c_str());
-        else std::fprintf(stderr, "whitted: error: rank %d: %s\n", mpi.rank(), error.c_str());
-    }
-    if (mpi.rank() == 0 && !root_failed) std::fprintf(stderr, "whitted: error: set-up failed on other ranks\n");
-    return false;
-}
-
 int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& given, MpiSession* mpi) {
     const bool root = !mpi || mpi->rank() == 0;
     if (root) {
@@ -272,7 +259,11 @@ int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& 
     }
     // The ranks agree on the set-up; rank 0, when its own succeeded, agrees once it serves tiles
     // (MpiTileServer), rendering its own meanwhile.
-    if (mpi && mpi->size() > 1 && (!root || !setup_error.empty()) && !setup_agreed(*mpi, setup_error)) return 1;
+    if (mpi && mpi->size() > 1 && (!root || !setup_error.empty()))
+        if (const std::optional<std::string> failed = mpi->agree_setup(setup_error)) {
+            if (!failed->empty()) std::fprintf(stderr, "whitted: error: %s\n", failed->c_str());
+            return 1;
+        }
     const Renderer& renderer = *renderer_ptr;
     if (mpi && mpi->size() > 1 && !root) {  // a worker rank: tiles for rank 0, nothing else
         g_mpi_running.store(true);

@@ -37,6 +37,15 @@ size_t tile_message_bytes(const PixelWindow& tile, const AovSet& a) {
     return sizeof(uint32_t) + per_pixel * size_t(tile.width()) * size_t(tile.height());
 }
 
+std::optional<std::string> MpiSession::agree_setup(const std::string& error) const {
+    if (all(error.empty())) return std::nullopt;
+    const bool root_failed = from_root(rank() == 0 && !error.empty());
+    if (!error.empty() && rank() == 0) return error;
+    if (!error.empty() && !root_failed) return fmt::format("rank {}: {}", rank(), error);
+    if (rank() == 0) return std::string("set-up failed on other ranks");
+    return std::string();
+}
+
 bool launched_by_mpi() {
     for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE", "MPI_LOCALNRANKS"})
         if (std::getenv(v)) return true;
@@ -251,10 +260,7 @@ void MpiTileServer::serve(const TakeTiles& take, const TileDone& give, RenderSta
     // The other ranks' set-up, agreed here rather than before the render (this rank's own set-up
     // succeeded, or it would not serve), so that this rank's tiles start while MPI and the other
     // ranks are still starting. The ranks that failed have said why.
-    if (!m_mpi.all(true)) {
-        m_mpi.from_root(false);
-        throw MpiSetupFailed();
-    }
+    if (const std::optional<std::string> failed = m_mpi.agree_setup("")) throw MpiSetupFailed(*failed);
     const std::vector<TileRect> tiles = m_renderer.tiles();
     int working = m_mpi.size() - 1;  // ranks that have not sent their final counters
     auto last_message = Clock::now();

@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "renderer/core/error.h"
@@ -45,6 +46,11 @@ public:
     bool all(bool ok) const;
     /// Collective: rank 0's `value`, on every rank.
     bool from_root(bool value) const;
+    /// Collective: the ranks agree on their set-up, `error` being this rank's (empty: it
+    /// succeeded). Nothing when every rank succeeded; else the one line this rank reports, empty
+    /// when another rank reports it: rank 0's error, else each failed rank's as "rank N: ...",
+    /// and on rank 0 "set-up failed on other ranks" when only others failed.
+    std::optional<std::string> agree_setup(const std::string& error) const;
     /// Ends every rank of the job with `code` (MPI_Abort; after finish(), only this process).
     [[noreturn]] void abort(int code) const;
     /// No more MPI calls from this process: MPI_Finalize starts on MPI's thread, without waiting.
@@ -60,7 +66,7 @@ private:
 /// Thrown on rank 0 when other ranks' set-up failed (they have printed why): no rank is left to
 /// abort, the job just ends.
 struct MpiSetupFailed : Error {
-    MpiSetupFailed() : Error("set-up failed on other ranks") {}
+    explicit MpiSetupFailed(const std::string& line) : Error(line) {}
 };
 
 /// The rank-0 side: tiles for the other ranks, for render_frame(renderer, options, &helpers).
