@@ -508,6 +508,7 @@ private:
     /// The JSON's top-level extensionsRequired, read on its own (the rest is skipped, not stored):
     /// any that whitted refuses is the error. JSON that does not parse is left to tinygltf.
     void refuse_unsupported_required(const char* json, size_t size) const {
+        if (std::string_view(json, size).find("extensionsRequired") == std::string_view::npos) return;
         const nlohmann::json::parser_callback_t keep_required = [](int depth, nlohmann::json::parse_event_t event,
                                                                   nlohmann::json& parsed) {
             return !(depth == 1 && event == nlohmann::json::parse_event_t::key && parsed != "extensionsRequired");
@@ -521,7 +522,7 @@ private:
             const ExtensionPolicy policy = extension_policy(name);
             if (policy.support != ExtensionSupport::Supported && policy.refuse_if_required)
                 fail(fmt::format("/extensionsRequired/{}", i), "required extension {} is not supported by whitted ({})",
-                     name, policy.known ? policy.note : "unknown extension");
+                     name, policy.note);
         }
     }
 
@@ -531,12 +532,10 @@ private:
             if (std::find(names.begin(), names.end(), r) == names.end()) names.push_back(r);
         for (size_t i = 0; i < names.size(); ++i) {
             const std::string& name = names[i];
-            const auto req = std::find(m_model.extensionsRequired.begin(), m_model.extensionsRequired.end(), name);
-            const bool required = req != m_model.extensionsRequired.end();
+            // A required one whitted refuses was reported before parsing (refuse_unsupported_required).
+            const bool required = std::find(m_model.extensionsRequired.begin(), m_model.extensionsRequired.end(),
+                                            name) != m_model.extensionsRequired.end();
             const ExtensionPolicy policy = extension_policy(name);
-            if (required && policy.support != ExtensionSupport::Supported && policy.refuse_if_required)
-                fail(fmt::format("/extensionsRequired/{}", req - m_model.extensionsRequired.begin()),
-                     "required extension {} is not supported by whitted ({})", name, policy.note);
             m_scene.extensions.push_back({name, policy.support, required, policy.note});
             if (policy.support == ExtensionSupport::Ignored)
                 m_warnings.add("ext:" + name, fmt::format("extension {} ignored: {}", name, policy.note));
