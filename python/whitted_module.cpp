@@ -423,12 +423,11 @@ PYBIND11_MODULE(whitted, m) {
             cs.display = display;
             cs.config = config;
             const DisplayTransform transform(cs);
-            const std::vector<uint16_t> codes = display_codes(pixels, transform, bits);
             const std::vector<py::ssize_t> shape{a.shape(0), a.shape(1), 3};
-            if (bits == 16) return py::array(py::array_t<uint16_t>(shape, codes.data()));
-            py::array_t<uint8_t> out(shape);
-            std::transform(codes.begin(), codes.end(), out.mutable_data(), [](uint16_t c) { return uint8_t(c); });
-            return py::array(out);
+            py::array out = bits == 16 ? py::array(py::array_t<uint16_t>(shape)) : py::array(py::array_t<uint8_t>(shape));
+            display_codes(pixels, transform, bits,
+                          std::span<uint8_t>(static_cast<uint8_t*>(out.mutable_data()), size_t(out.nbytes())));
+            return out;
         },
         py::arg("beauty"), py::arg("view") = "Standard", py::arg("display") = "", py::arg("ocio_config") = "",
         py::arg("bits") = 8,

@@ -158,8 +158,11 @@ const std::string& DisplayTransform::view() const { return m_impl->view; }
 
 // ---- image files -----------------------------------------------------------------------------
 
-std::vector<uint16_t> display_codes(std::span<const Color> pixels, const DisplayTransform& transform, int bits) {
+void display_codes(std::span<const Color> pixels, const DisplayTransform& transform, int bits, std::span<uint8_t> out) {
     if (bits != 8 && bits != 16) throw Error(fmt::format("unsupported bit depth {} (use 8 or 16)", bits));
+    const size_t bytes_per_code = bits == 16 ? 2 : 1;
+    if (out.size() != pixels.size() * 3 * bytes_per_code)
+        throw Error(fmt::format("display_codes: {} bytes for {} pixels of {} bits", out.size(), pixels.size(), bits));
     // Sanitize before the transform: NaN -> 0 and +-inf -> +-65504 (half max), so that
     // transforms mixing channels (the ACES matrices) never turn one bad channel into NaN.
     constexpr float kLarge = 65504.f;
@@ -171,15 +174,19 @@ std::vector<uint16_t> display_codes(std::span<const Color> pixels, const Display
         }
     transform.apply(rgb.data(), pixels.size());
     const float scale = bits == 16 ? 65535.f : 255.f;
-    std::vector<uint16_t> codes(rgb.size());
     for (size_t i = 0; i < rgb.size(); ++i) {
         // After the transform (OCIO does not clamp): NaN -> 0, then clamp to [0, 1] (+inf -> 1),
         // then round to nearest. Deterministic: no dithering.
         float v = rgb[i];
         v = std::isnan(v) ? 0.f : std::clamp(v, 0.f, 1.f);
-        codes[i] = static_cast<uint16_t>(static_cast<uint32_t>(v * scale + 0.5f));
+        const auto code = static_cast<uint32_t>(v * scale + 0.5f);
+        if (bits == 16) {
+            const auto q = static_cast<uint16_t>(code);
+            std::memcpy(&out[2 * i], &q, 2);
+        } else {
+            out[i] = static_cast<uint8_t>(code);
+        }
     }
-    return codes;
 }
 
 namespace {
@@ -327,24 +334,16 @@ EncodedImage encode_display(const Film& film, FileKind kind, const OutputSetting
         throw Error(fmt::format("{}: unsupported bit depth {} (use 8 or 16)", path, settings.bits));
     if (bits == 16 && kind == FileKind::Jpeg) throw Error(fmt::format("{}: JPEG supports only 8 bits", path));
 
-    std::optional<DisplayTransform> transform;
-    std::vector<uint16_t> codes;
-    try {
-        transform.emplace(settings.color);
-        codes = display_codes(film.beauty, *transform, bits);
-    } catch (const Error& e) {
-        throw Error(fmt::format("{}: {}", path, e.what()));
-    }
-
     EncodedImage image;
     image.format = bits == 16 ? OIIO::TypeUInt16 : OIIO::TypeUInt8;
     image.spec = OIIO::ImageSpec(film.width(), film.height(), 3, image.format);
-    if (bits == 16) {
-        image.bytes.resize(codes.size() * 2);
-        std::memcpy(image.bytes.data(), codes.data(), image.bytes.size());
-    } else {
-        image.bytes.resize(codes.size());
-        for (size_t i = 0; i < codes.size(); ++i) image.bytes[i] = static_cast<unsigned char>(codes[i]);
+    image.bytes.resize(film.beauty.size() * 3 * (bits == 16 ? 2 : 1));
+    std::optional<DisplayTransform> transform;
+    try {
+        transform.emplace(settings.color);
+        display_codes(film.beauty, *transform, bits, image.bytes);
+    } catch (const Error& e) {
+        throw Error(fmt::format("{}: {}", path, e.what()));
     }
 
     if (kind == FileKind::Tiff) image.spec.attribute("compression", "zip");

@@ -43,10 +43,12 @@ private:
     std::unique_ptr<Impl> m_impl;
 };
 
-/// Display-referred codes of scene-linear pixels (RGB interleaved), exactly as write_image
-/// quantises PNG, JPEG and TIFF: NaN -> 0 and +-inf -> +-65504, the transform (OCIO), then
-/// clamped to [0, 1] and rounded to `bits` (8 or 16). Throws whitted::Error for other bit depths.
-std::vector<uint16_t> display_codes(std::span<const Color> pixels, const DisplayTransform& transform, int bits);
+/// Display-referred codes of scene-linear pixels, exactly as write_image quantises PNG, JPEG and
+/// TIFF: NaN -> 0 and +-inf -> +-65504, the transform (OCIO), then clamped to [0, 1] and rounded
+/// to `bits`, written into `out` as RGB interleaved: one byte per code for 8 bits, two (uint16_t,
+/// native order) for 16. Throws whitted::Error for other bit depths or when `out` is not
+/// pixels.size() * 3 codes long.
+void display_codes(std::span<const Color> pixels, const DisplayTransform& transform, int bits, std::span<uint8_t> out);
 
 struct OutputSettings {
     ColorSettings color;
