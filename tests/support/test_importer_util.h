@@ -69,6 +69,29 @@ inline std::string write_file(const std::string& name, const std::vector<uint8_t
     return p.string();
 }
 
+/// A GLB file: `json` as its JSON chunk (padded with spaces to 4 bytes) and, when `bin` is not
+/// empty, a BIN chunk (padded with zeros).
+inline std::vector<uint8_t> make_glb(std::string json, std::vector<uint8_t> bin = {}) {
+    while (json.size() % 4) json += ' ';
+    while (bin.size() % 4) bin.push_back(0);
+    std::vector<uint8_t> glb;
+    auto u32 = [&](uint32_t v) {
+        for (int i = 0; i < 4; ++i) glb.push_back(uint8_t(v >> (8 * i)));
+    };
+    u32(0x46546C67);  // "glTF"
+    u32(2);
+    u32(uint32_t(12 + 8 + json.size() + (bin.empty() ? 0 : 8 + bin.size())));
+    u32(uint32_t(json.size()));
+    u32(0x4E4F534A);  // "JSON"
+    glb.insert(glb.end(), json.begin(), json.end());
+    if (!bin.empty()) {
+        u32(uint32_t(bin.size()));
+        u32(0x004E4942);  // "BIN\0"
+        glb.insert(glb.end(), bin.begin(), bin.end());
+    }
+    return glb;
+}
+
 inline std::vector<uint8_t> read_bytes(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};

@@ -824,20 +824,8 @@ TEST(GltfHandMade, RequiredCompressionIsNamedBeforeItsConsequences) {
                            " is not supported by whitted"),
                   std::string::npos)
             << err;
-        // The same JSON as a GLB's JSON chunk (padded with spaces to 4 bytes).
-        std::string chunk = json;
-        while (chunk.size() % 4) chunk += ' ';
-        std::vector<uint8_t> glb;
-        auto u32 = [&](uint32_t v) {
-            for (int i = 0; i < 4; ++i) glb.push_back(uint8_t(v >> (8 * i)));
-        };
-        u32(0x46546C67);
-        u32(2);
-        u32(uint32_t(20 + chunk.size()));
-        u32(uint32_t(chunk.size()));
-        u32(0x4E4F534A);
-        glb.insert(glb.end(), chunk.begin(), chunk.end());
-        const std::string glb_path = write_file(std::string(name) + ".glb", glb);
+        // The same JSON as a GLB's JSON chunk.
+        const std::string glb_path = write_file(std::string(name) + ".glb", make_glb(json));
         const std::string glb_err = error_text([&] { load_scene(glb_path); });
         EXPECT_NE(glb_err.find("/extensionsRequired/0: required extension " + std::string(ext)), std::string::npos)
             << glb_err;
@@ -892,24 +880,7 @@ TEST(GltfHandMade, MeshoptStreamsDecodeIntoTheFallbackBuffer) {
     };
     check(load_scene(write_file("meshopt.gltf", json_with(4, compressed, false))));
     // The same as a GLB (its JSON chunk rewritten; the chunk after it kept).
-    std::string chunk = json_with(4, compressed, true);
-    while (chunk.size() % 4) chunk += ' ';
-    std::vector<uint8_t> bin = compressed;
-    while (bin.size() % 4) bin.push_back(0);
-    std::vector<uint8_t> glb;
-    auto u32 = [&](uint32_t v) {
-        for (int i = 0; i < 4; ++i) glb.push_back(uint8_t(v >> (8 * i)));
-    };
-    u32(0x46546C67);
-    u32(2);
-    u32(uint32_t(12 + 8 + chunk.size() + 8 + bin.size()));
-    u32(uint32_t(chunk.size()));
-    u32(0x4E4F534A);
-    glb.insert(glb.end(), chunk.begin(), chunk.end());
-    u32(uint32_t(bin.size()));
-    u32(0x004E4942);
-    glb.insert(glb.end(), bin.begin(), bin.end());
-    check(load_scene(write_file("meshopt.glb", glb)));
+    check(load_scene(write_file("meshopt.glb", make_glb(json_with(4, compressed, true), compressed))));
 
     std::vector<uint8_t> corrupt = compressed;
     for (size_t i = 1; i < vstream.size(); ++i) corrupt[i] = 0xFF;
