@@ -50,7 +50,7 @@ constexpr std::array kTable = {
     Entry{"EXT_texture_webp", S, false, "WebP images decoded (libwebp), preferred over the core source"},
     Entry{"EXT_texture_avif", I, true, "AVIF images not decoded; the core texture source is used when present"},
     Entry{"MSFT_texture_dds", I, true, "DDS images not decoded; the core texture source is used when present"},
-    Entry{"KHR_draco_mesh_compression", I, true, "not decoded; the uncompressed fallback attributes are used"},
+    Entry{"KHR_draco_mesh_compression", S, false, "decoded (Draco): every attribute by its id, and the indices"},
     Entry{"EXT_meshopt_compression", S, false, "decoded (meshoptimizer): ATTRIBUTES, TRIANGLES, INDICES; OCTAHEDRAL, QUATERNION, EXPONENTIAL filters"},
     Entry{"EXT_lights_image_based", I, false, "no image-based lighting"},
     Entry{"MSFT_lod", I, false, "the node's own (highest detail) mesh is used"},

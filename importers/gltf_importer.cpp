@@ -32,6 +32,8 @@
 #include "importers/gltf_accessor.h"
 #include "importers/gltf_extensions.h"
 #include "importers/gltf_json.h"
+#include "importers/gltf_compressed.h"
+#include "importers/gltf_draco.h"
 #include "importers/gltf_meshopt.h"
 #include "importers/gltf_validation.h"
 #include "importers/image_decode.h"
@@ -417,9 +419,10 @@ private:
         // complain about its consequences (a Draco primitive's accessors have no bufferView).
         refuse_unsupported_required(reinterpret_cast<const char*>(bytes.data()) + json_offset, json_size);
 
-        // EXT_meshopt_compression's fallback buffers carry no data: they get a uri the file
-        // callbacks serve as zeros, and the streams are decoded into them after parsing.
-        const std::optional<std::vector<uint8_t>> rewritten = with_fallback_uris(bytes, binary, json_offset, json_size);
+        // Compressed geometry: EXT_meshopt_compression's fallback buffers carry no data (they get a
+        // uri the file callbacks serve as zeros), a Draco primitive's indices accessor has no
+        // bufferView (it moves out of tinygltf's sight); both are decoded after parsing.
+        const std::optional<std::vector<uint8_t>> rewritten = prepare_compressed(bytes, binary, json_offset, json_size);
         const std::span<const uint8_t> file = rewritten ? std::span<const uint8_t>(*rewritten) : bytes;
 
         m_loader.keep_bytes = m_options.load_textures;
@@ -478,6 +481,9 @@ private:
             fail("", "glTF parse error: {}", msg);
         }
         decode_meshopt_views(m_model, m_path);
+        m_scene.compressed = meshopt_primitives(m_model);
+        for (CompressedPrimitive& r : decode_draco_primitives(m_model, m_path, m_options.max_memory))
+            m_scene.compressed.push_back(std::move(r));
         // tinygltf reports an image it could not find as a warning; whitted treats it as an error
         // (check_images_present), so only keep the other warnings.
         size_t start = 0;

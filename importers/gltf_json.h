@@ -2,9 +2,13 @@
 // Private to importers/. tinygltf's own Value::Get asserts on type mismatch; these never do.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
+#include <fmt/format.h>
 #include <tiny_gltf.h>
+
+#include "importers/located_error.h"
 
 namespace whitted::gltf {
 
@@ -33,6 +37,24 @@ inline bool as_int(const tinygltf::Value* v, int& out) {
     if (!(d >= -2147483648.0 && d <= 2147483647.0) || d != double(int(d))) return false;
     out = int(d);
     return true;
+}
+
+/// A non-negative integer member of an extension object; `fallback` when absent. Anything else
+/// throws whitted::Error at `path`, JSON pointer `ptr`/key.
+inline size_t extension_uint(const tinygltf::Value& ext, const char* key, size_t fallback, const std::string& path,
+                             const std::string& ptr) {
+    const tinygltf::Value* v = find_member(&ext, key);
+    if (v == nullptr) return fallback;
+    int i = -1;
+    if (!as_int(v, i) || i < 0)
+        throw Error(file_loc(path, ptr + "/" + key), fmt::format("{} must be a non-negative integer", key));
+    return size_t(i);
+}
+
+/// A string member of an extension object; `fallback` when absent or not a string.
+inline std::string extension_text(const tinygltf::Value& ext, const char* key, const char* fallback) {
+    const tinygltf::Value* v = find_member(&ext, key);
+    return v != nullptr && v->IsString() ? v->Get<std::string>() : std::string(fallback);
 }
 
 }  // namespace whitted::gltf

@@ -23,21 +23,6 @@ constexpr const char* kMarker = "whitted-meshopt-fallback-";
     throw Error(loc, message);
 }
 
-/// A non-negative integer member of an extension object; `fallback` when absent.
-size_t member(const tinygltf::Value& ext, const char* key, size_t fallback, const std::string& path,
-              const std::string& ptr) {
-    const tinygltf::Value* v = gltf::find_member(&ext, key);
-    if (v == nullptr) return fallback;
-    int i = -1;
-    if (!gltf::as_int(v, i) || i < 0) fail(path, ptr + "/" + key, fmt::format("{} must be a non-negative integer", key));
-    return size_t(i);
-}
-
-std::string text_member(const tinygltf::Value& ext, const char* key, const char* fallback) {
-    const tinygltf::Value* v = gltf::find_member(&ext, key);
-    return v != nullptr && v->IsString() ? v->Get<std::string>() : std::string(fallback);
-}
-
 }  // namespace
 
 std::string meshopt_fallback_uri(size_t buffer, size_t bytes) { return fmt::format("{}{}-{}", kMarker, buffer, bytes); }
@@ -55,12 +40,8 @@ std::optional<size_t> meshopt_fallback_size(const std::string& lookup) {
     }
 }
 
-std::optional<std::vector<uint8_t>> with_fallback_uris(std::span<const uint8_t> file, bool binary, size_t json_offset,
-                                                       size_t json_size) {
-    const char* json = reinterpret_cast<const char*>(file.data()) + json_offset;
-    if (std::string_view(json, json_size).find(kExt) == std::string_view::npos) return std::nullopt;
-    nlohmann::json doc = nlohmann::json::parse(json, json + json_size, nullptr, false);
-    if (!doc.is_object() || !doc.contains("buffers") || !doc["buffers"].is_array()) return std::nullopt;
+bool add_meshopt_fallback_uris(nlohmann::json& doc, bool binary) {
+    if (!doc.is_object() || !doc.contains("buffers") || !doc["buffers"].is_array()) return false;
     bool changed = false;
     nlohmann::json& buffers = doc["buffers"];
     for (size_t i = 0; i < buffers.size(); ++i) {
@@ -74,23 +55,7 @@ std::optional<std::vector<uint8_t>> with_fallback_uris(std::span<const uint8_t> 
         b["uri"] = meshopt_fallback_uri(i, length.get<size_t>());
         changed = true;
     }
-    if (!changed) return std::nullopt;
-    std::string text = doc.dump();
-    std::vector<uint8_t> out;
-    if (!binary) return std::vector<uint8_t>(text.begin(), text.end());
-    while (text.size() % 4) text += ' ';
-    auto u32 = [&](uint32_t v) {
-        for (int k = 0; k < 4; ++k) out.push_back(uint8_t(v >> (8 * k)));
-    };
-    const size_t rest = json_offset + json_size;  // the chunks after JSON, unchanged
-    u32(0x46546C67);
-    u32(2);
-    u32(uint32_t(12 + 8 + text.size() + (file.size() - rest)));
-    u32(uint32_t(text.size()));
-    u32(0x4E4F534A);
-    out.insert(out.end(), text.begin(), text.end());
-    out.insert(out.end(), file.begin() + std::ptrdiff_t(rest), file.end());
-    return out;
+    return changed;
 }
 
 void decode_meshopt_views(tinygltf::Model& model, const std::string& path) {
@@ -104,15 +69,15 @@ void decode_meshopt_views(tinygltf::Model& model, const std::string& path) {
             fail(path, fmt::format("/bufferViews/{}/buffer", i), "buffer out of range");
         tinygltf::Buffer& target = model.buffers[size_t(view.buffer)];
         if (target.uri.rfind(kMarker, 0) != 0) continue;  // the buffer has data of its own: use it
-        const size_t source = member(ext, "buffer", size_t(-1), path, ptr);
+        const size_t source = gltf::extension_uint(ext, "buffer", size_t(-1), path, ptr);
         if (source >= model.buffers.size()) fail(path, ptr + "/buffer", "source buffer out of range");
         const std::vector<unsigned char>& src = model.buffers[source].data;
-        const size_t offset = member(ext, "byteOffset", 0, path, ptr);
-        const size_t length = member(ext, "byteLength", size_t(-1), path, ptr);
-        const size_t stride = member(ext, "byteStride", 0, path, ptr);
-        const size_t count = member(ext, "count", size_t(-1), path, ptr);
-        const std::string mode = text_member(ext, "mode", "");
-        const std::string filter = text_member(ext, "filter", "NONE");
+        const size_t offset = gltf::extension_uint(ext, "byteOffset", 0, path, ptr);
+        const size_t length = gltf::extension_uint(ext, "byteLength", size_t(-1), path, ptr);
+        const size_t stride = gltf::extension_uint(ext, "byteStride", 0, path, ptr);
+        const size_t count = gltf::extension_uint(ext, "count", size_t(-1), path, ptr);
+        const std::string mode = gltf::extension_text(ext, "mode", "");
+        const std::string filter = gltf::extension_text(ext, "filter", "NONE");
         if (length == size_t(-1) || count == size_t(-1)) fail(path, ptr, "byteLength and count are required");
         if (offset > src.size() || length > src.size() - offset)
             fail(path, ptr, fmt::format("bytes {}..{} are outside source buffer {} ({} bytes)", offset, offset + length,

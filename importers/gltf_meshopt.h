@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
 #include <tiny_gltf.h>
 
 namespace whitted {
@@ -20,11 +21,9 @@ std::string meshopt_fallback_uri(size_t buffer, size_t bytes);
 /// When `lookup` (a path tinygltf asks for) names a fallback buffer: its size.
 std::optional<size_t> meshopt_fallback_size(const std::string& lookup);
 
-/// The file with every EXT_meshopt_compression fallback buffer that has no uri given
-/// meshopt_fallback_uri(); nullopt when there is none (the file is used as it is). `json` is the
-/// file's JSON (all of it, or a GLB's JSON chunk at `json_offset`); a GLB comes back as a GLB.
-std::optional<std::vector<uint8_t>> with_fallback_uris(std::span<const uint8_t> file, bool binary, size_t json_offset,
-                                                       size_t json_size);
+/// Gives every EXT_meshopt_compression fallback buffer without a uri meshopt_fallback_uri(), in
+/// the file's JSON before tinygltf parses it (gltf_compressed.h); true when anything changed.
+bool add_meshopt_fallback_uris(nlohmann::json& doc, bool binary);
 
 /// Decodes every bufferView's EXT_meshopt_compression stream (ATTRIBUTES, TRIANGLES, INDICES;
 /// filters NONE, OCTAHEDRAL, QUATERNION, EXPONENTIAL) into its fallback buffer, after checking

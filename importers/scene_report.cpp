@@ -263,6 +263,10 @@ std::string describe_scene(const Scene& scene) {
     for (const ExtensionUse& e : scene.extensions)
         line(fmt::format("extension: {} {} required={} note=\"{}\"", e.name, support_name(e.support),
                          yes_no(e.required), e.note));
+    for (const CompressedPrimitive& c : scene.compressed)
+        line(fmt::format("compressed: primitive={} codec={} compressed_bytes={} decoded_bytes={} ratio={}", c.pointer,
+                         c.codec, c.compressed_bytes, c.decoded_bytes,
+                         c.compressed_bytes ? num(double(c.decoded_bytes) / double(c.compressed_bytes)) : "inf"));
     for (const std::string& w : scene.warnings) line("warning: " + w);
     out += describe_analysis(scene, analyze_scene(scene));
     return out;

@@ -260,6 +260,15 @@ struct ExtensionUse {
     std::string note;                 ///< e.g. "first frame / bind pose"
 };
 
+/// A glTF primitive whose geometry the file stores compressed (KHR_draco_mesh_compression,
+/// EXT_meshopt_compression), as `whitted info` reports it.
+struct CompressedPrimitive {
+    std::string pointer;              ///< JSON pointer, "/meshes/0/primitives/1"
+    std::string codec;                ///< "draco" or "meshopt"
+    uint64_t compressed_bytes = 0;    ///< the streams' bytes in the file
+    uint64_t decoded_bytes = 0;       ///< the accessors' data they decode to
+};
+
 // ---------------------------------------------------------------------------------------------
 // Render settings a scene file may carry; command-line flags override them. Unset = the
 // renderer's default.
@@ -300,6 +309,7 @@ struct Scene {
     std::optional<Environment> environment;  ///< what rays that leave the scene see, and its light
     std::vector<Camera> cameras;
     std::vector<ExtensionUse> extensions;
+    std::vector<CompressedPrimitive> compressed;  ///< glTF primitives stored compressed
     std::vector<std::string> warnings;  ///< each distinct warning once
     SceneRenderSettings settings;     ///< from a scene file; empty for glTF
 

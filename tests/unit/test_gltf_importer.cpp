@@ -781,13 +781,15 @@ TEST(GltfHandMade, RequiredExtensions) {
     EXPECT_NE(err.find("/extensionsRequired/0: required extension EXT_unknown_thing is not supported"),
               std::string::npos)
         << err;
-    const std::string draco = write_gltf(
-        "draco.gltf",
+    // An extension refused when required (KTX2 textures) is named as that.
+    const std::string basisu = write_gltf(
+        "basisu.gltf",
         edit(
             kQuadJson, R"("asset": {"version": "2.0"},)",
-            R"("asset": {"version": "2.0"}, "extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"],)"),
+            R"("asset": {"version": "2.0"}, "extensionsUsed": ["KHR_texture_basisu"], "extensionsRequired": ["KHR_texture_basisu"],)"),
         quad_bin());
-    EXPECT_NE(error_text([&] { load_scene(draco); }).find("KHR_draco_mesh_compression"), std::string::npos);
+    EXPECT_NE(error_text([&] { load_scene(basisu); }).find("required extension KHR_texture_basisu is not supported"),
+              std::string::npos);
     // Used but not required: ignored with one warning each; an ignorable one may even be required.
     const std::string soft = write_gltf(
         "soft_ext.gltf",
@@ -804,20 +806,20 @@ TEST(GltfHandMade, RequiredExtensions) {
     EXPECT_EQ(warnings_containing(s, "extension EXT_foo ignored"), 1u);
 }
 
-// Compressed files name the extension they need, not its consequences: a Draco primitive's
-// accessors have no bufferView (tinygltf said "accessor[1] invalid bufferView"); in a .gltf and in
-// a GLB's JSON chunk.
+// Files name the extension they need, not its consequences: a primitive compressed by an unknown
+// codec has accessors without bufferView (tinygltf would say "accessor[1] invalid bufferView"); in
+// a .gltf and in a GLB's JSON chunk.
 TEST(GltfHandMade, RequiredCompressionIsNamedBeforeItsConsequences) {
-    const std::string draco_json = R"({"asset": {"version": "2.0"},
-      "extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"],
+    const std::string other_json = R"({"asset": {"version": "2.0"},
+      "extensionsUsed": ["EXT_other_mesh_compression"], "extensionsRequired": ["EXT_other_mesh_compression"],
       "buffers": [{"byteLength": 4, "uri": "data:application/octet-stream;base64,AAAAAA=="}],
       "bufferViews": [{"buffer": 0, "byteLength": 4}],
       "accessors": [{"componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
                     {"componentType": 5123, "count": 3, "type": "SCALAR"}],
       "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "extensions":
-        {"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}}}]}],
+        {"EXT_other_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}}}]}],
       "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]})";
-    for (const auto& [name, json, ext] : {std::tuple{"draco_req.gltf", draco_json, "KHR_draco_mesh_compression"}}) {
+    for (const auto& [name, json, ext] : {std::tuple{"other_req.gltf", other_json, "EXT_other_mesh_compression"}}) {
         const std::string path = write_file(name, json);
         const std::string err = error_text([&] { load_scene(path); });
         EXPECT_NE(err.find(path + ": /extensionsRequired/0: required extension " + std::string(ext) +
@@ -878,7 +880,13 @@ TEST(GltfHandMade, MeshoptStreamsDecodeIntoTheFallbackBuffer) {
         ASSERT_EQ(m.indices.size(), 6u);
         for (size_t k = 0; k < 6; ++k) EXPECT_EQ(m.indices[k], indices[k]);
     };
-    check(load_scene(write_file("meshopt.gltf", json_with(4, compressed, false))));
+    const Scene plain = load_scene(write_file("meshopt.gltf", json_with(4, compressed, false)));
+    check(plain);
+    // `whitted info`'s record: both views' streams against their decoded 48 + 12 bytes.
+    ASSERT_EQ(plain.compressed.size(), 1u);
+    EXPECT_EQ(plain.compressed[0].codec, "meshopt");
+    EXPECT_EQ(plain.compressed[0].compressed_bytes, vstream.size() + istream.size());
+    EXPECT_EQ(plain.compressed[0].decoded_bytes, 60u);
     // The same as a GLB (its JSON chunk rewritten; the chunk after it kept).
     check(load_scene(write_file("meshopt.glb", make_glb(json_with(4, compressed, true), compressed))));
 
