@@ -28,6 +28,7 @@ constexpr const char* kIndices = "whitted_indices";  // where detach_draco_indic
 struct Job {
     size_t mesh = 0, primitive = 0;
     size_t view = 0;
+    size_t stream = 0;                       ///< index into the decoded streams (one per view)
     int indices = -1;                        ///< accessor, -1 without
     std::map<std::string, uint32_t> ids;     ///< attribute name -> Draco unique id
     std::string ptr;                         ///< JSON pointer of the extension object
@@ -264,12 +265,15 @@ std::vector<CompressedPrimitive> decode_draco_primitives(tinygltf::Model& model,
     // Decode each stream once, in parallel.
     std::vector<size_t> views;
     std::map<size_t, size_t> stream_of_view;
-    for (const Job& j : jobs)
-        if (stream_of_view.emplace(j.view, views.size()).second) views.push_back(j.view);
+    for (Job& j : jobs) {
+        const auto [it, fresh] = stream_of_view.emplace(j.view, views.size());
+        if (fresh) views.push_back(j.view);
+        j.stream = it->second;
+    }
     std::vector<Stream> streams(views.size());
     tbb::parallel_for(size_t(0), views.size(), [&](size_t k) { streams[k] = decode_stream(model, views[k]); });
     for (const Job& j : jobs)
-        if (const Stream& s = streams[stream_of_view[j.view]]; !s.error.empty()) fail(j.ptr, s.error);
+        if (const Stream& s = streams[j.stream]; !s.error.empty()) fail(j.ptr, s.error);
 
     // Each accessor is filled once: by the first primitive that names it. One named by primitives
     // with different streams is ambiguous.
@@ -294,7 +298,7 @@ std::vector<CompressedPrimitive> decode_draco_primitives(tinygltf::Model& model,
     std::vector<Output> outputs(jobs.size());
     tbb::parallel_for(size_t(0), jobs.size(), [&](size_t k) {
         const Job& j = jobs[k];
-        const draco::Mesh& mesh = *streams[stream_of_view[j.view]].mesh;
+        const draco::Mesh& mesh = *streams[j.stream].mesh;
         Output& out = outputs[k];
         auto error = [&](int accessor, std::string message) {
             if (out.error.empty()) out.error = std::move(message), out.error_ptr = fmt::format("/accessors/{}", accessor);

@@ -416,7 +416,8 @@ private:
             fail("", "invalid JSON: arrays/objects nested deeper than {} levels", kMaxJsonDepth);
 
         // A required extension whitted cannot honour is reported as that, before tinygltf gets to
-        // complain about its consequences (a Draco primitive's accessors have no bufferView).
+        // complain about its consequences (a primitive of an unknown codec has accessors without
+        // bufferView).
         refuse_unsupported_required(reinterpret_cast<const char*>(bytes.data()) + json_offset, json_size);
 
         // Compressed geometry: EXT_meshopt_compression's fallback buffers carry no data (they get a
