@@ -2,16 +2,22 @@
 // assets/gltf/<Model>/glTF-<Variant>/ are made by scripts/make_compressed_assets.sh (glTF
 // Transform). Box's meshopt variant is lossless (floats, no filters): the same image, bit for
 // bit. The others are lossy (quantization, WebP): each is held to the PSNR measured for it, with
-// a margin (docs/measurements/compressed-gltf.md). Correctness only: no timings here.
+// a margin (docs/measurements/compressed-gltf.md). Bundled models re-encoded losslessly at test
+// time with libmeshoptimizer (tests/support/meshopt_reencode.h, which changes nothing but the
+// bufferViews) render bit for bit like their originals. Correctness only: no timings here.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <string>
 
 #include "importers/scene_loader.h"
 #include "renderer/integrator/render.h"
 #include "renderer/scene/scene_builder.h"
+#include "tests/support/meshopt_reencode.h"
 
 namespace whitted {
 namespace {
@@ -49,6 +55,15 @@ struct Variant {
 
 class CompressedVariant : public ::testing::TestWithParam<Variant> {};
 
+/// "Duck_glTF_Draco" for "Duck/glTF-Draco/Duck.glb": the test's name.
+std::string variant_name(const ::testing::TestParamInfo<Variant>& info) {
+    std::string name = std::string(info.param.variant);
+    name = name.substr(0, name.rfind('/'));
+    for (char& c : name)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+    return name;
+}
+
 TEST_P(CompressedVariant, RendersLikeTheOriginal) {
     const Variant& v = GetParam();
     const Film original = render_file(kAssets + v.original);
@@ -63,7 +78,39 @@ INSTANTIATE_TEST_SUITE_P(Assets, CompressedVariant,
                                            Variant{"Duck/glTF-Binary/Duck.glb", "Duck/glTF-MeshoptFiltered/Duck.glb", 66},
                                            Variant{"Duck/glTF-Binary/Duck.glb", "Duck/glTF-WebP/Duck.glb", 62},
                                            Variant{"Box/glTF-Binary/Box.glb", "Box/glTF-Draco/Box.glb", 90},
-                                           Variant{"Box/glTF-Binary/Box.glb", "Box/glTF-Meshopt/Box.glb", INFINITY}));
+                                           Variant{"Box/glTF-Binary/Box.glb", "Box/glTF-Meshopt/Box.glb", INFINITY}),
+                         variant_name);
+
+class LosslessMeshopt : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(LosslessMeshopt, RendersBitForBitLikeTheOriginal) {
+    const std::string original = kAssets + GetParam();
+    const test::MeshoptReencoded encoded = test::meshopt_reencode(test::read_bytes(original));
+    EXPECT_GT(encoded.attribute_views, 0);
+    EXPECT_GT(encoded.triangle_views + encoded.index_views, 0);
+    const std::string path = test::write_file(std::filesystem::path(GetParam()).filename().string(), encoded.glb);
+    const Scene scene = load_scene(path);
+    ASSERT_FALSE(scene.compressed.empty());
+    EXPECT_EQ(scene.compressed.front().codec, "meshopt");
+    const Film a = render_file(original), b = render_file(path);
+    ASSERT_EQ(a.beauty.size(), b.beauty.size());
+    size_t differing = 0;
+    for (size_t i = 0; i < a.beauty.size(); ++i)
+        differing += std::memcmp(&a.beauty[i], &b.beauty[i], sizeof(a.beauty[i])) != 0;
+    std::printf("%s: %d ATTRIBUTES, %d TRIANGLES, %d INDICES views; %zu of %zu pixels differ\n", GetParam(),
+                encoded.attribute_views, encoded.triangle_views, encoded.index_views, differing, a.beauty.size());
+    EXPECT_EQ(differing, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Assets, LosslessMeshopt,
+                         ::testing::Values("Duck/glTF-Binary/Duck.glb", "BoxInterleaved/glTF-Binary/BoxInterleaved.glb",
+                                           "BoxVertexColors/glTF-Binary/BoxVertexColors.glb",
+                                           "TextureSettingsTest/glTF-Binary/TextureSettingsTest.glb",
+                                           "NegativeScaleTest/glTF-Binary/NegativeScaleTest.glb",
+                                           "GlassHurricaneCandleHolder/glTF-Binary/GlassHurricaneCandleHolder.glb"),
+                         [](const ::testing::TestParamInfo<const char*>& info) {
+                             return std::filesystem::path(info.param).stem().string();
+                         });
 
 }  // namespace
 }  // namespace whitted
