@@ -225,6 +225,63 @@ FileLoc locate(const JsonDocument& doc, const std::string& pointer, bool at_key)
     return loc;
 }
 
+namespace {
+
+/// The SAX handler of parse_json_document: builds the document (nlohmann's DOM builder) and tracks the pointer of what
+/// is being parsed, refuses duplicate keys and deep nesting, and records the order of
+/// /materials and /textures (nlohmann::json sorts keys). Not Json::parse with a callback: its
+/// builder scans the parent container at the end of every object, quadratic in the length of
+/// /objects.
+struct Sax {
+    nlohmann::detail::json_sax_dom_parser<Json> dom;
+    JsonDocument& doc;
+    std::vector<Frame> frames;
+    void value() {
+        if (!frames.empty() && !frames.back().is_object) ++frames.back().index;
+    }
+    void open(bool is_object) {
+        value();
+        if (frames.size() >= size_t(kMaxJsonDepth))
+            throw CallbackError{fmt::format("invalid JSON: arrays/objects nested deeper than {} levels", kMaxJsonDepth),
+                                frames_pointer(frames)};
+        Frame f;
+        f.is_object = is_object;
+        frames.push_back(std::move(f));
+    }
+    void close() {
+        if (!frames.empty()) frames.pop_back();
+    }
+    bool null() { return value(), dom.null(); }
+    bool boolean(bool v) { return value(), dom.boolean(v); }
+    bool number_integer(Json::number_integer_t v) { return value(), dom.number_integer(v); }
+    bool number_unsigned(Json::number_unsigned_t v) { return value(), dom.number_unsigned(v); }
+    bool number_float(Json::number_float_t v, const Json::string_t& s) { return value(), dom.number_float(v, s); }
+    bool string(Json::string_t& v) { return value(), dom.string(v); }
+    bool binary(Json::binary_t& v) { return value(), dom.binary(v); }
+    bool start_object(size_t n) { return open(true), dom.start_object(n); }
+    bool end_object() { return close(), dom.end_object(); }
+    bool start_array(size_t n) { return open(false), dom.start_array(n); }
+    bool end_array() { return close(), dom.end_array(); }
+    bool key(Json::string_t& k) {
+        Frame& f = frames.back();
+        f.key = k;
+        if (!f.keys.insert(f.key).second)
+            throw CallbackError{fmt::format("duplicate key '{}' (each key may appear once per object)", f.key),
+                                frames_pointer(frames)};
+        if (frames.size() == 2 && frames[1].is_object && frames[0].is_object) {
+            if (frames[0].key == "materials") doc.material_order.push_back(f.key);
+            if (frames[0].key == "textures") doc.texture_order.push_back(f.key);
+        }
+        return dom.key(k);
+    }
+    template <class Exception>
+    bool parse_error(size_t at, const std::string& token, const Exception& e) {
+        return dom.parse_error(at, token, e);
+    }
+};
+
+}  // namespace
+
 JsonDocument parse_json_document(std::string text, const std::string& path) {
     JsonDocument doc;
     doc.path = path;
@@ -233,48 +290,10 @@ JsonDocument parse_json_document(std::string text, const std::string& path) {
     if (t.size() >= 3 && (unsigned char)t[0] == 0xEF && (unsigned char)t[1] == 0xBB && (unsigned char)t[2] == 0xBF)
         fail_at(path, t, 0, "", "invalid JSON: the file starts with a UTF-8 byte order mark (save it without one)");
 
-    // The callback tracks the pointer of what is being parsed, refuses duplicate keys and deep
-    // nesting, and records the order of /materials and /textures (nlohmann::json sorts keys).
-    std::vector<Frame> frames;
-    auto callback = [&](int, Json::parse_event_t event, Json& parsed) -> bool {
-        switch (event) {
-            case Json::parse_event_t::object_start:
-            case Json::parse_event_t::array_start: {
-                if (!frames.empty() && !frames.back().is_object) ++frames.back().index;
-                if (frames.size() >= size_t(kMaxJsonDepth))
-                    throw CallbackError{fmt::format("invalid JSON: arrays/objects nested deeper than {} levels",
-                                                    kMaxJsonDepth),
-                                        frames_pointer(frames)};
-                Frame f;
-                f.is_object = event == Json::parse_event_t::object_start;
-                frames.push_back(std::move(f));
-                break;
-            }
-            case Json::parse_event_t::object_end:
-            case Json::parse_event_t::array_end:
-                if (!frames.empty()) frames.pop_back();
-                break;
-            case Json::parse_event_t::key: {
-                Frame& f = frames.back();
-                f.key = parsed.get<std::string>();
-                if (!f.keys.insert(f.key).second)
-                    throw CallbackError{fmt::format("duplicate key '{}' (each key may appear once per object)", f.key),
-                                        frames_pointer(frames)};
-                if (frames.size() == 2 && frames[1].is_object && frames[0].is_object) {
-                    if (frames[0].key == "materials") doc.material_order.push_back(f.key);
-                    if (frames[0].key == "textures") doc.texture_order.push_back(f.key);
-                }
-                break;
-            }
-            case Json::parse_event_t::value:
-                if (!frames.empty() && !frames.back().is_object) ++frames.back().index;
-                break;
-        }
-        return true;
-    };
-
+    // The handler (above) builds the document and checks it as it goes.
     try {
-        doc.root = Json::parse(doc.text, callback);
+        Sax sax{nlohmann::detail::json_sax_dom_parser<Json>(doc.root), doc, {}};
+        Json::sax_parse(doc.text, &sax);
     } catch (const CallbackError& e) {
         // The pointer is known; the offset of a duplicate key is the last member of that name.
         const TextPosition p = find_pointer(t, e.pointer);

@@ -255,7 +255,7 @@ public:
     using Accelerator::intersect;
 
     EmbreeAccelerator(const Scene& scene, const SurfaceFilter& filter, const EmbreeConfig& config)
-        : m_filter(filter), m_packet_width(config.packet_width) {
+        : m_filter(filter), m_packet_width(config.packet_width), m_compact(config.compact) {
         auto start = std::chrono::steady_clock::now();
         std::string device_config = config.threads > 0 ? "threads=" + std::to_string(config.threads) : "";
         m_device = rtcNewDevice(device_config.c_str());
@@ -361,6 +361,15 @@ public:
 
     Hit intersect(const Ray& ray, RayKind kind) const override {
         if (!ray_is_traceable(ray)) return Hit{};  // NaN/zero-direction rays: Embree asserts on them
+        if (m_compact) {
+            // Compact leaves (Triangle4i) get a different single-ray kernel than packets on some
+            // ISAs (seen on AVX2: 2-6 % of rays missed or hit differently than rtcIntersect4/8/16
+            // and the default leaves, docs/accelerators.md); a one-lane packet takes the same
+            // kernel as every batch.
+            Hit h;
+            intersect_packets<4>(std::span<const Ray>(&ray, 1), kind, std::span<Hit>(&h, 1));
+            return h;
+        }
         QueryContext q = context(&ray, kind);
         RTCRayHit rh;
         set_rtc_ray(rh.ray, ray);  // id 0: q.rays[0]
@@ -482,6 +491,7 @@ private:
     std::atomic<int64_t> m_device_bytes{0};  ///< the memory monitor's count for m_device
     size_t m_sphere_bytes = 0;               ///< SpherePrims, ours (user data)
     int m_packet_width = 4;   ///< EmbreeConfig::packet_width
+    bool m_compact = false;   ///< EmbreeConfig::compact: single rays go through one-lane packets
 };
 
 }  // namespace
