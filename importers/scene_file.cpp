@@ -641,9 +641,15 @@ private:
     void read_objects(const Json& v) {
         if (!v.is_array()) expected(v, "/objects", "an array of objects");
         std::map<std::string, int> counts;
-        for (size_t i = 0; i < v.size(); ++i) {
+        int& sphere_count = counts["sphere"];
+        for (size_t i = 0; i < m_doc.objects.size(); ++i) {
+            const auto [begin, end] = m_doc.objects[i];
+            if (scene_file::SphereFields f;
+                scene_file::scan_sphere(std::string_view(m_doc.text).substr(begin, end - begin), f) &&
+                add_scanned_sphere(f, sphere_count))
+                continue;
             const std::string ptr = sub("/objects", i);
-            const Json& o = v[i];
+            const Json o = scene_file::parse_object(m_doc, i);
             if (!o.is_object()) expected(o, ptr, "an object (sphere, plane, box or mesh)");
             const std::string type =
                 choice(require(o, "type", ptr, "an object", "\"sphere\", \"plane\", \"box\" or \"mesh\""),
@@ -655,6 +661,31 @@ private:
             else if (type == "box") read_box(o, ptr, name);
             else read_mesh(o, ptr, name);
         }
+    }
+
+    /// The fast path of read_sphere (no DOM, no pointers): a sphere scan_sphere read whose values
+    /// pass read_sphere's checks, with the same result; false leaves it to the general path.
+    bool add_scanned_sphere(const scene_file::SphereFields& f, int& count) {
+        const double limit = double(std::numeric_limits<float>::max());
+        for (const double c : f.center)
+            if (!(std::fabs(c) <= limit)) return false;
+        if (!(f.radius > 0 && f.radius <= limit)) return false;
+        uint32_t material = 0;
+        if (f.has_material) {
+            const auto it = m_material_index.find(f.material);
+            if (it == m_material_index.end()) return false;
+            material = it->second;
+        } else {
+            material = default_material();
+        }
+        Sphere s;
+        s.name = f.has_name ? std::string(f.name) : fmt::format("sphere {}", count);
+        ++count;
+        s.center = Vec3d(f.center[0], f.center[1], f.center[2]);
+        s.radius = f.radius;
+        s.material = material;
+        m_scene.spheres.push_back(std::move(s));
+        return true;
     }
 
     void read_sphere(const Json& o, const std::string& ptr, const std::string& name) {
@@ -1151,7 +1182,7 @@ private:
     size_t m_bytes = 0;                               ///< memory estimate so far
     Scene m_scene;
     WarningLog m_warnings;
-    std::map<std::string, uint32_t> m_material_index; ///< file material name -> Scene material
+    std::map<std::string, uint32_t, std::less<>> m_material_index; ///< file material name -> Scene material
     std::vector<std::string> m_material_names;        ///< in file order (suggestions)
     std::map<std::string, NamedTexture> m_textures;
     std::vector<std::string> m_texture_names;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <unordered_set>
@@ -227,50 +228,79 @@ FileLoc locate(const JsonDocument& doc, const std::string& pointer, bool at_key)
 
 namespace {
 
-/// The SAX handler of parse_json_document: builds the document (nlohmann's DOM builder) and tracks the pointer of what
-/// is being parsed, refuses duplicate keys and deep nesting, and records the order of
-/// /materials and /textures (nlohmann::json sorts keys). Not Json::parse with a callback: its
-/// builder scans the parent container at the end of every object, quadratic in the length of
-/// /objects.
+/// The SAX handler of parse_json_document and parse_object: builds the value (nlohmann's DOM
+/// builder) and tracks the pointer of what is being parsed, refuses duplicate keys and deep
+/// nesting, and records the order of /materials and /textures (nlohmann::json sorts keys). Not
+/// Json::parse with a callback: its builder scans the parent container at the end of every
+/// object, quadratic in the length of /objects.
+///
+/// With `stream_objects`, the elements of the root's /objects array are checked for syntax only
+/// and left out of the value (they are parsed one at a time by parse_object, so a file of a
+/// million spheres never holds a million-element DOM).
 struct Sax {
     nlohmann::detail::json_sax_dom_parser<Json> dom;
-    JsonDocument& doc;
+    JsonDocument* doc = nullptr;      ///< receives the material/texture order (the whole file)
+    std::string base;                 ///< pointer of the value being parsed ("" or /objects/i)
+    size_t base_depth = 0;            ///< its nesting depth in the file
+    bool stream_objects = false;
     std::vector<Frame> frames;
+    size_t skip_from = SIZE_MAX;      ///< frames.size() of the /objects frame: deeper is skipped
+
+    bool skipping() const { return frames.size() >= skip_from; }
+    std::string pointer() const { return base + frames_pointer(frames); }
     void value() {
         if (!frames.empty() && !frames.back().is_object) ++frames.back().index;
     }
     void open(bool is_object) {
         value();
-        if (frames.size() >= size_t(kMaxJsonDepth))
+        if (base_depth + frames.size() >= size_t(kMaxJsonDepth))
             throw CallbackError{fmt::format("invalid JSON: arrays/objects nested deeper than {} levels", kMaxJsonDepth),
-                                frames_pointer(frames)};
+                                pointer()};
         Frame f;
         f.is_object = is_object;
         frames.push_back(std::move(f));
     }
-    void close() {
+    /// After a container closed: whether the builder sees it.
+    bool close() {
         if (!frames.empty()) frames.pop_back();
+        if (frames.size() + 1 == skip_from) skip_from = SIZE_MAX;  // /objects itself closed
+        return !skipping();
     }
-    bool null() { return value(), dom.null(); }
-    bool boolean(bool v) { return value(), dom.boolean(v); }
-    bool number_integer(Json::number_integer_t v) { return value(), dom.number_integer(v); }
-    bool number_unsigned(Json::number_unsigned_t v) { return value(), dom.number_unsigned(v); }
-    bool number_float(Json::number_float_t v, const Json::string_t& s) { return value(), dom.number_float(v, s); }
-    bool string(Json::string_t& v) { return value(), dom.string(v); }
-    bool binary(Json::binary_t& v) { return value(), dom.binary(v); }
-    bool start_object(size_t n) { return open(true), dom.start_object(n); }
-    bool end_object() { return close(), dom.end_object(); }
-    bool start_array(size_t n) { return open(false), dom.start_array(n); }
-    bool end_array() { return close(), dom.end_array(); }
+    bool null() { return value(), skipping() || dom.null(); }
+    bool boolean(bool v) { return value(), skipping() || dom.boolean(v); }
+    bool number_integer(Json::number_integer_t v) { return value(), skipping() || dom.number_integer(v); }
+    bool number_unsigned(Json::number_unsigned_t v) { return value(), skipping() || dom.number_unsigned(v); }
+    bool number_float(Json::number_float_t v, const Json::string_t& s) {
+        return value(), skipping() || dom.number_float(v, s);
+    }
+    bool string(Json::string_t& v) { return value(), skipping() || dom.string(v); }
+    bool binary(Json::binary_t& v) { return value(), skipping() || dom.binary(v); }
+    bool start_object(size_t n) {
+        const bool skip = skipping();
+        open(true);
+        return skip || dom.start_object(n);
+    }
+    bool start_array(size_t n) {
+        const bool skip = skipping();
+        open(false);
+        if (stream_objects && frames.size() == 2 && frames[0].is_object && frames[0].key == "objects") {
+            skip_from = 2;
+            doc->objects_streamed = true;
+        }
+        return skip || dom.start_array(n);
+    }
+    bool end_object() { return !close() || dom.end_object(); }
+    bool end_array() { return !close() || dom.end_array(); }
     bool key(Json::string_t& k) {
         Frame& f = frames.back();
         f.key = k;
+        if (skipping()) return true;  // checked when parse_object reads the element
         if (!f.keys.insert(f.key).second)
             throw CallbackError{fmt::format("duplicate key '{}' (each key may appear once per object)", f.key),
-                                frames_pointer(frames)};
-        if (frames.size() == 2 && frames[1].is_object && frames[0].is_object) {
-            if (frames[0].key == "materials") doc.material_order.push_back(f.key);
-            if (frames[0].key == "textures") doc.texture_order.push_back(f.key);
+                                pointer()};
+        if (doc && frames.size() == 2 && frames[1].is_object && frames[0].is_object) {
+            if (frames[0].key == "materials") doc->material_order.push_back(f.key);
+            if (frames[0].key == "textures") doc->texture_order.push_back(f.key);
         }
         return dom.key(k);
     }
@@ -279,6 +309,19 @@ struct Sax {
         return dom.parse_error(at, token, e);
     }
 };
+
+/// [begin, end) offsets of the elements of the array at `at` in valid JSON `t`.
+std::vector<std::pair<size_t, size_t>> element_spans(std::string_view t, size_t at) {
+    std::vector<std::pair<size_t, size_t>> spans;
+    size_t i = skip_ws(t, at + 1);
+    while (i < t.size() && t[i] != ']') {
+        const size_t end = skip_value(t, i);
+        spans.emplace_back(i, end);
+        i = skip_ws(t, end);
+        if (i < t.size() && t[i] == ',') i = skip_ws(t, i + 1);
+    }
+    return spans;
+}
 
 }  // namespace
 
@@ -292,8 +335,9 @@ JsonDocument parse_json_document(std::string text, const std::string& path) {
 
     // The handler (above) builds the document and checks it as it goes.
     try {
-        Sax sax{nlohmann::detail::json_sax_dom_parser<Json>(doc.root), doc, {}};
+        Sax sax{nlohmann::detail::json_sax_dom_parser<Json>(doc.root), &doc, "", 0, true, {}};
         Json::sax_parse(doc.text, &sax);
+        if (doc.objects_streamed) doc.objects = element_spans(t, find_pointer(t, "/objects").value);
     } catch (const CallbackError& e) {
         // The pointer is known; the offset of a duplicate key is the last member of that name.
         const TextPosition p = find_pointer(t, e.pointer);
@@ -309,6 +353,115 @@ JsonDocument parse_json_document(std::string text, const std::string& path) {
         throw Error(FileLoc{path, "", 0, 0}, "out of memory while parsing the JSON");
     }
     return doc;
+}
+
+Json parse_object(const JsonDocument& doc, size_t i) {
+    const auto [begin, end] = doc.objects.at(i);
+    Json value;
+    try {
+        Sax sax{nlohmann::detail::json_sax_dom_parser<Json>(value), nullptr, fmt::format("/objects/{}", i), 2, false, {}};
+        Json::sax_parse(std::string_view(doc.text).substr(begin, end - begin), &sax);
+    } catch (const CallbackError& e) {
+        const TextPosition p = find_pointer(doc.text, e.pointer);
+        fail_at(doc.path, doc.text, p.key != std::string::npos ? p.key : p.value, e.pointer, e.message);
+    }
+    // Syntax and numbers were checked when the whole file was parsed.
+    return value;
+}
+
+namespace {
+
+/// A plain JSON string at t[i] (a quote): its contents, i past the closing quote. False when it
+/// has escapes (the general path decodes those).
+bool scan_plain_string(std::string_view t, size_t& i, std::string_view& out) {
+    if (i >= t.size() || t[i] != '"') return false;
+    const size_t begin = ++i;
+    while (i < t.size() && t[i] != '"') {
+        if (t[i] == '\\') return false;
+        ++i;
+    }
+    if (i >= t.size()) return false;
+    out = t.substr(begin, i - begin);
+    ++i;
+    return true;
+}
+
+/// A JSON number at t[i], converted as nlohmann::json converts it (integers as 64-bit integers,
+/// then to double; others with correct rounding). False when out of range (the general path
+/// reports or rounds those).
+bool scan_number(std::string_view t, size_t& i, double& out) {
+    const size_t begin = i;
+    bool integer = true;
+    while (i < t.size() && (std::isdigit(static_cast<unsigned char>(t[i])) || t[i] == '-' || t[i] == '+' ||
+                            t[i] == '.' || t[i] == 'e' || t[i] == 'E')) {
+        integer &= t[i] != '.' && t[i] != 'e' && t[i] != 'E';
+        ++i;
+    }
+    if (i == begin || i - begin > 40) return false;
+    const char* first = t.data() + begin;
+    const char* last = t.data() + i;
+    if (integer) {
+        long long v = 0;
+        const auto r = std::from_chars(first, last, v);
+        out = double(v);
+        return r.ec == std::errc() && r.ptr == last;
+    }
+    const auto r = std::from_chars(first, last, out);
+    return r.ec == std::errc() && r.ptr == last;
+}
+
+}  // namespace
+
+bool scan_sphere(std::string_view t, SphereFields& f) {
+    enum : unsigned { kType = 1, kCenter = 2, kRadius = 4, kMaterial = 8, kName = 16 };
+    unsigned seen = 0;
+    size_t i = skip_ws(t, 0);
+    if (i >= t.size() || t[i] != '{') return false;
+    i = skip_ws(t, i + 1);
+    while (true) {
+        std::string_view key;
+        if (!scan_plain_string(t, i, key)) return false;
+        i = skip_ws(t, i);
+        if (i >= t.size() || t[i] != ':') return false;
+        i = skip_ws(t, i + 1);
+        unsigned bit = 0;
+        if (key == "type") {
+            std::string_view type;
+            if (!scan_plain_string(t, i, type) || type != "sphere") return false;
+            bit = kType;
+        } else if (key == "center") {
+            if (i >= t.size() || t[i] != '[') return false;
+            for (int k = 0; k < 3; ++k) {
+                i = skip_ws(t, i + 1);
+                if (!scan_number(t, i, f.center[k])) return false;
+                i = skip_ws(t, i);
+                if (i >= t.size() || t[i] != (k < 2 ? ',' : ']')) return false;
+            }
+            ++i;
+            bit = kCenter;
+        } else if (key == "radius") {
+            if (!scan_number(t, i, f.radius)) return false;
+            bit = kRadius;
+        } else if (key == "material") {
+            if (!scan_plain_string(t, i, f.material)) return false;
+            bit = kMaterial;
+        } else if (key == "name") {
+            if (!scan_plain_string(t, i, f.name)) return false;
+            bit = kName;
+        } else {
+            return false;
+        }
+        if (seen & bit) return false;
+        seen |= bit;
+        i = skip_ws(t, i);
+        if (i < t.size() && t[i] == '}') break;
+        if (i >= t.size() || t[i] != ',') return false;
+        i = skip_ws(t, i + 1);
+    }
+    if (skip_ws(t, i + 1) != t.size() || (seen & (kType | kCenter | kRadius)) != (kType | kCenter | kRadius)) return false;
+    f.has_material = seen & kMaterial;
+    f.has_name = seen & kName;
+    return true;
 }
 
 std::string closest_match(std::string_view name, const std::vector<std::string>& candidates) {

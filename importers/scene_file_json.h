@@ -27,11 +27,34 @@ struct JsonDocument {
     Json root;
     std::vector<std::string> material_order;  ///< keys of /materials in file order
     std::vector<std::string> texture_order;   ///< keys of /textures in file order
+    /// When /objects is an array: its elements' [begin, end) offsets in `text`. They are not in
+    /// `root` (whose /objects is an empty array): parse_object reads one at a time.
+    bool objects_streamed = false;
+    std::vector<std::pair<size_t, size_t>> objects;
 };
 
 /// Parses `text`. Throws whitted::Error at line:column for invalid JSON, a duplicate key, nesting
 /// deeper than kMaxJsonDepth or a number out of double range.
 JsonDocument parse_json_document(std::string text, const std::string& path);
+
+/// Element `i` of /objects (objects_streamed), with the checks of parse_json_document (duplicate
+/// keys, depth) located in the whole file.
+Json parse_object(const JsonDocument& doc, size_t i);
+
+/// A sphere element of /objects as scan_sphere reads it straight from the text.
+struct SphereFields {
+    double center[3] = {0, 0, 0};
+    double radius = 0;
+    std::string_view material, name;  ///< into the element's text (no escapes)
+    bool has_material = false, has_name = false;
+};
+
+/// Whether element text `e` (valid JSON) is exactly a sphere object: the keys "type" (the string
+/// "sphere"), "center" (3 numbers), "radius" (a number) and optionally "material" and "name"
+/// (strings without escapes), each once, in any order; then `f` holds its values, numbers as
+/// nlohmann::json reads them. False for anything else, which the general path reads (with its
+/// checks and errors). The fast path of files with many spheres: no DOM per element.
+bool scan_sphere(std::string_view e, SphereFields& f);
 
 /// Where the JSON pointer `pointer` is in valid JSON `text`: byte offsets of the value and (for
 /// an object member) of its key; when a duplicate key occurs the last member counts (as in the

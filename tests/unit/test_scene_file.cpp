@@ -2,6 +2,7 @@
 // error class names the file, the JSON pointer and line:column, includes compose with glTF.
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <numbers>
 #include <string>
@@ -304,6 +305,50 @@ TEST(SceneFile, SpheresAndDefaultMaterial) {
     EXPECT_EQ(u.spheres[0].material, 0u);
     // Never empty.
     EXPECT_EQ(load_json(doc("")).materials.size(), 1u);
+}
+
+// Plain sphere objects take a fast path (scan_sphere: no DOM per element); anything else in the
+// element (here a "comment") sends it through the general reader. Both give the same spheres,
+// bit for bit: numbers as nlohmann reads them (integers, -0, exponents, 17 digits), names,
+// default names, materials, the default material; and values the fast path leaves to the
+// general one (an unknown material, a radius of 0) still fail there with the located error.
+TEST(SceneFile, SphereFastPathMatchesTheGeneralReader) {
+    const std::vector<std::string> spheres = {
+        R"("type": "sphere", "center": [1, -2, 3], "radius": 0.5, "material": "m")",
+        R"("center": [-0, 0.0, -0.0], "radius": 2, "type": "sphere")",
+        R"("type":"sphere","name":"né","center":[1e3,-2.5E-3,0.30000000000000004],"radius":1e-7)",
+        R"("type": "sphere", "name": "ball", "material": "m", "center": [ 123456789012, 7 , 1.5e+2 ], "radius": 3.25)",
+        R"("type": "sphere", "center": [1, 2, 3], "radius": 1, "name": "plain")"};
+    auto file = [&](bool comment) {
+        std::string objects;
+        for (const std::string& body : spheres)
+            objects += std::string(objects.empty() ? "" : ",\n") + "{" + body + (comment ? R"(, "comment": "x")" : "") + "}";
+        return doc(R"("materials": {"m": {"kd": 1}}, "objects": [)" + objects + "]");
+    };
+    const Scene fast = load_json(file(false), {}, "fast.json");
+    const Scene general = load_json(file(true), {}, "general.json");
+    ASSERT_EQ(fast.spheres.size(), spheres.size());
+    ASSERT_EQ(general.spheres.size(), spheres.size());
+    for (size_t i = 0; i < spheres.size(); ++i) {
+        SCOPED_TRACE(spheres[i]);
+        const Sphere& a = fast.spheres[i];
+        const Sphere& b = general.spheres[i];
+        EXPECT_EQ(a.name, b.name);
+        EXPECT_EQ(a.material, b.material);
+        EXPECT_EQ(std::memcmp(&a.center, &b.center, sizeof(a.center)), 0);
+        EXPECT_EQ(std::memcmp(&a.radius, &b.radius, sizeof(a.radius)), 0);
+    }
+    EXPECT_EQ(fast.spheres[1].name, "sphere 1");
+    EXPECT_TRUE(std::signbit(fast.spheres[1].center.z));  // -0.0 stays negative, -0 is an integer 0
+    EXPECT_FALSE(std::signbit(fast.spheres[1].center.x));
+    EXPECT_EQ(fast.spheres[2].name, "n\xC3\xA9");       // an escape: the general path decodes it
+    EXPECT_EQ(fast.materials.size(), general.materials.size());
+    const Error unknown = error_of(doc(R"("objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1},
+      {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "nope"}])"));
+    EXPECT_EQ(unknown.location().pointer, "/objects/1/material");
+    EXPECT_CONTAINS(std::string(unknown.what()), "unknown material 'nope'");
+    const Error zero = error_of(doc(R"("objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 0}])"));
+    EXPECT_EQ(zero.location().pointer, "/objects/0/radius");
 }
 
 TEST(SceneFile, InfinitePlanes) {
