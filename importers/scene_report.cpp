@@ -287,8 +287,10 @@ std::string describe_analysis(const Scene& scene, const SceneAnalysis& a) {
                      yes_no(f.varying), yes_no(f.emissive), yes_no(f.unlit), yes_no(f.volume), yes_no(f.single_sided),
                      yes_no(f.highlight), yes_no(f.diffuse)));
     const double per_tri = a.triangles ? double(a.scene_bytes) / double(a.triangles) : 0.0;
-    line(fmt::format("analysis memory: triangles={} scene_bytes={} bytes_per_triangle={} texture_bytes={}", a.triangles,
-                     a.scene_bytes, num(per_tri), a.texture_bytes));
+    const double per_sphere = a.spheres ? double(a.sphere_bytes) / double(a.spheres) : 0.0;
+    line(fmt::format("analysis memory: triangles={} scene_bytes={} bytes_per_triangle={} texture_bytes={} spheres={} "
+                     "sphere_bytes={} bytes_per_sphere={}",
+                     a.triangles, a.scene_bytes, num(per_tri), a.texture_bytes, a.spheres, a.sphere_bytes, num(per_sphere)));
     for (size_t i = 0; i < a.materials.size(); ++i) {
         const MaterialFeatures& m = a.materials[i];
         line(fmt::format("analysis material[{}]: used={} diffuse={} highlight={} mirror={} transmission={} emissive={} "

@@ -158,6 +158,10 @@ SceneAnalysis analyze_scene(const Scene& scene, const MappingOptions& mapping) {
     for (const Texture& t : scene.textures)
         for (const MipLevel& level : t.levels) a.texture_bytes += bytes_of(level.texels);
     a.triangles = scene.instanced_triangle_count();
+    a.spheres = scene.spheres.size();
+    a.sphere_bytes = scene.spheres.capacity() * sizeof(Sphere);
+    for (const Sphere& sp : scene.spheres)
+        if (sp.name.capacity() > std::string().capacity()) a.sphere_bytes += sp.name.capacity() + 1;  // beyond the SSO buffer
 
     // Per material: varying = evaluated per hit; the OR over the used ones.
     SceneFeatures& s = a.features;

@@ -94,6 +94,8 @@ struct SceneAnalysis {
     size_t scene_bytes = 0;                   ///< mesh data (positions, normals, tangents, UVs, colors, indices)
     size_t texture_bytes = 0;                 ///< decoded texels, all MIP levels
     size_t triangles = 0;                     ///< instanced triangles
+    size_t spheres = 0;                       ///< analytic spheres
+    size_t sphere_bytes = 0;                  ///< their records (Scene::spheres, names included)
 
     /// The lights that may reach object `o`, in ascending order (the order of Scene::lights).
     std::span<const uint32_t> lights_of(uint32_t o) const {

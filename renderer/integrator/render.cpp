@@ -75,9 +75,11 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
     }
     m_build_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     const AccelStats as = m_accel->stats();
-    log_info("accelerator: {}{}, built in {:.3f}s, {:.1f} MiB", m_accel->name(),
+    const size_t primitives = scene.instanced_triangle_count() + scene.spheres.size();
+    log_info("accelerator: {}{}, built in {:.3f}s, {:.1f} MiB ({:.1f} B per triangle or sphere)", m_accel->name(),
              m_accel->name() == "embree" ? (settings.robust ? " (robust)" : " (not robust: --no-robust)") : "",
-             m_build_seconds, double(as.bytes) / double(1 << 20));
+             m_build_seconds, double(as.bytes) / double(1 << 20),
+             primitives ? double(as.bytes) / double(primitives) : 0.0);
 }
 
 Renderer::~Renderer() = default;

@@ -55,6 +55,21 @@ TEST(SkipCli, InfoPrintsTheAnalysis) {
     EXPECT_TRUE(contains(r.out, "\nanalysis: opaque=no recursive=yes")) << r.out;
     EXPECT_TRUE(contains(r.out, "\nanalysis memory: triangles=")) << r.out;
     EXPECT_TRUE(contains(r.out, "\nanalysis material[0]: used=yes")) << r.out;
+    // Memory per primitive: the spheres' records (at least the Sphere struct each).
+    const size_t at = r.out.find("bytes_per_sphere=");
+    ASSERT_NE(at, std::string::npos) << r.out;
+    EXPECT_GE(std::stod(r.out.substr(at + 17)), double(sizeof(double) * 4)) << r.out;
+    EXPECT_FALSE(contains(r.out, " spheres=0 ")) << r.out;
+}
+
+TEST(SkipCli, RenderPrintsAcceleratorBytesPerPrimitive) {
+    const fs::path out = temp_dir("accel_bytes") / "a.png";
+    const Result r = run("render '" + kScene + "' --width 16 --height 12 --aa center --no-progress -o '" + out.string() + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const size_t at = r.err.find(" B per triangle or sphere)");
+    ASSERT_NE(at, std::string::npos) << r.err;
+    const size_t open = r.err.rfind('(', at);
+    EXPECT_GT(std::stod(r.err.substr(open + 1)), 0.0) << r.err;
 }
 
 // bench skip on a small render: the specialised kernel's image equals the general one at
