@@ -1,4 +1,4 @@
-// OpenImageIO -> EnvironmentImage (linear RGB), with the limits checked from the header first.
+// An image file (OpenImageIO, through renderer/core/image_files.h) -> EnvironmentImage (linear RGB), with the limits checked from the header first.
 
 #include "importers/environment_image.h"
 
@@ -6,7 +6,6 @@
 #include <cmath>
 #include <filesystem>
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -14,6 +13,7 @@
 #include "importers/one_line.h"
 #include "renderer/core/data_files.h"
 #include "renderer/core/error.h"
+#include "renderer/core/image_files.h"
 #include "shading/environment_map.h"
 
 namespace whitted {
@@ -61,23 +61,25 @@ EnvironmentImage load_environment_image(const std::string& path, size_t max_memo
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw Error(loc, "cannot read the environment map: no such file");
     if (!std::filesystem::is_regular_file(path, ec)) throw Error(loc, "cannot read the environment map: not a file");
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) {
-        const std::string why = one_line(OIIO::geterror());
+    std::unique_ptr<ImageFileReader> in;
+    try {
+        in = open_image_file(path);
+    } catch (const Error& e) {
+        const std::string why = one_line(e.what());
         throw Error(loc, fmt::format("cannot read the environment map: not an image OpenImageIO reads ({})",
                                      why.empty() ? "unknown format" : why));
     }
 
     // The header first: a small file must not make us allocate a huge image.
-    const OIIO::ImageSpec& spec = in->spec();
-    if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1)
+    const ImageDesc& spec = in->desc();
+    if (spec.width < 1 || spec.height < 1 || spec.channels() < 1)
         throw Error(loc, fmt::format("the environment map is empty ({}x{}, {} channels)", spec.width, spec.height,
-                                     spec.nchannels));
+                                     spec.channels()));
     if (spec.depth > 1) throw Error(loc, fmt::format("the environment map is a volume ({} slices)", spec.depth));
     if (spec.width > kMaxImageSide || spec.height > kMaxImageSide)
         throw Error(loc, fmt::format("the environment map is {}x{}, more than the {} texels per side whitted accepts",
                                      spec.width, spec.height, kMaxImageSide));
-    const int channels = spec.nchannels >= 3 ? 3 : 1;  // RGB, or grey (a second channel is alpha)
+    const int channels = spec.channels() >= 3 ? 3 : 1;  // RGB, or grey (a second channel is alpha)
     const size_t needed = environment_load_bytes(spec.width, spec.height, channels);
     if (needed > max_memory_bytes)
         throw Error(loc, fmt::format("the environment map is {}x{}: loading it needs about {} MiB, more than the limit "
@@ -89,14 +91,16 @@ EnvironmentImage load_environment_image(const std::string& path, size_t max_memo
                                        path, spec.width, spec.height));
 
     // Integer files hold sRGB-encoded values (PNG, JPEG) unless they say they are linear.
-    const std::string color_space = spec.get_string_attribute("oiio:ColorSpace");
-    const bool srgb = !spec.format.is_floating_point() && color_space != "Linear" && color_space != "linear";
+    const std::string color_space = spec.attribute("oiio:ColorSpace");
+    const bool srgb = !spec.floating_point && color_space != "Linear" && color_space != "linear";
 
     const size_t texels = size_t(spec.width) * size_t(spec.height);
     std::vector<float> px(texels * size_t(channels));
-    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, px.data()))
-        throw Error(loc, fmt::format("cannot read the environment map: {}", one_line(in->geterror())));
-    in->close();
+    try {
+        in->read(0, channels, PixelType::Float, px.data());
+    } catch (const Error& e) {
+        throw Error(loc, fmt::format("cannot read the environment map: {}", one_line(e.what())));
+    }
 
     EnvironmentImage image;
     image.name = std::filesystem::path(path).stem().string();

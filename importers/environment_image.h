@@ -1,5 +1,5 @@
 // Environment maps from files (OpenImageIO: EXR, HDR, TIFF, PNG, JPEG) and the bundled names
-// (docs/environment.md). Kept in its own translation unit because OIIO's headers are heavy.
+// (docs/environment.md). Read through renderer/core/image_files.h (OIIO, loaded on first use).
 #pragma once
 
 #include <cstddef>

@@ -1,4 +1,4 @@
-// OpenImageIO -> RGBA8 texture level (scene-file image textures).
+// An image file (OpenImageIO, through renderer/core/image_files.h) -> RGBA8 texture level (scene-file image textures).
 
 #include "importers/scene_file_image.h"
 
@@ -6,10 +6,10 @@
 #include <cmath>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include "importers/image_decode.h"
+#include "renderer/core/image_files.h"
 #include "shading/texture_sampling.h"
 
 namespace whitted {
@@ -23,23 +23,34 @@ std::string one_line(std::string s) {
     return s;
 }
 
+void read_pixels(ImageFileReader& in, int channels, PixelType type, void* out, const std::string& file,
+                 const FileLoc& loc) {
+    try {
+        in.read(0, channels, type, out);
+    } catch (const Error& e) {
+        throw Error(loc, fmt::format("cannot read image '{}': {}", file, one_line(e.what())));
+    }
+}
+
 }  // namespace
 
 LoadedImage load_image_file(const std::string& file, size_t max_memory, const FileLoc& loc) {
-    auto in = OIIO::ImageInput::open(file);
-    if (!in) {
-        const std::string why = one_line(OIIO::geterror());
+    std::unique_ptr<ImageFileReader> in;
+    try {
+        in = open_image_file(file);
+    } catch (const Error& e) {
+        const std::string why = one_line(e.what());
         throw Error(loc, fmt::format("cannot read image '{}': {}", file, why.empty() ? "unknown format" : why));
     }
-    const OIIO::ImageSpec& spec = in->spec();
+    const ImageDesc& spec = in->desc();
     // The header first: a small file must not make us allocate a huge image.
     if (spec.depth > 1) throw Error(loc, fmt::format("image '{}' is a volume ({} slices): not supported", file, spec.depth));
     if (const std::string refused = check_image_size(spec.width, spec.height, max_memory); !refused.empty())
         throw Error(loc, fmt::format("image '{}' refused: {}", file, refused));
-    if (spec.nchannels < 1) throw Error(loc, fmt::format("image '{}' has no channels", file));
+    if (spec.channels() < 1) throw Error(loc, fmt::format("image '{}' has no channels", file));
 
-    const int channels = std::min(spec.nchannels, 4);
-    const bool is_float = spec.format.is_floating_point();
+    const int channels = std::min(spec.channels(), 4);
+    const bool is_float = spec.floating_point;
     const size_t texels = size_t(spec.width) * size_t(spec.height);
     LoadedImage out;
     out.float_data = is_float;
@@ -50,8 +61,7 @@ LoadedImage load_image_file(const std::string& file, size_t max_memory, const Fi
     // Expand 1 (gray), 2 (gray, alpha), 3 (RGB) or 4 channels to RGBA.
     if (is_float) {
         std::vector<float> px(texels * size_t(channels));
-        if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, px.data()))
-            throw Error(loc, fmt::format("cannot read image '{}': {}", file, one_line(in->geterror())));
+        read_pixels(*in, channels, PixelType::Float, px.data(), file, loc);
         for (size_t i = 0; i < texels; ++i) {
             const float* v = &px[i * size_t(channels)];
             uint8_t* o = &out.level.texels[i * 4];
@@ -62,8 +72,7 @@ LoadedImage load_image_file(const std::string& file, size_t max_memory, const Fi
         }
     } else {
         std::vector<uint8_t> px(texels * size_t(channels));
-        if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, px.data()))
-            throw Error(loc, fmt::format("cannot read image '{}': {}", file, one_line(in->geterror())));
+        read_pixels(*in, channels, PixelType::UInt8, px.data(), file, loc);
         for (size_t i = 0; i < texels; ++i) {
             const uint8_t* v = &px[i * size_t(channels)];
             uint8_t* o = &out.level.texels[i * 4];
@@ -73,7 +82,6 @@ LoadedImage load_image_file(const std::string& file, size_t max_memory, const Fi
             o[3] = channels == 2 ? v[1] : channels == 4 ? v[3] : 255;
         }
     }
-    in->close();
     return out;
 }
 

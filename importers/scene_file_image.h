@@ -1,5 +1,5 @@
-// Image files for scene-file textures, read through OpenImageIO (private to importers/; kept in
-// its own translation unit because OIIO's headers are heavy).
+// Image files for scene-file textures, read through OpenImageIO (renderer/core/image_files.h,
+// loaded on first use; private to importers/).
 #pragma once
 
 #include <cstddef>

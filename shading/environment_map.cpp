@@ -4,6 +4,7 @@
 #include "shading/environment_map.h"
 
 #include <algorithm>
+#include <utility>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -264,7 +265,8 @@ void tangent_frame(const Vec3f& n, Vec3f& t, Vec3f& b) {
 /// The GGX prefilter of a pyramid, one lat-long per kPrefilterRoughness, by filtered importance
 /// sampling (Krivanek & Colbert 2008): a fixed Hammersley set per texel, each sample read from the
 /// MIP level whose texel matches its solid angle.
-std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::Level>& source, WorkerPool& pool) {
+std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::Level>& source, uint32_t levels,
+                                            WorkerPool& pool) {
     const double texel_sr = 4.0 * kPiD / (double(source.front().width) * double(source.front().height));
     std::vector<EnvironmentMap::Level> out;
     struct Row {
@@ -274,10 +276,12 @@ std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::L
     std::vector<Row> rows;
     for (size_t k = 0; k < kPrefilterRoughness.size(); ++k) {
         EnvironmentMap::Level level;
-        level.width = kPrefilterWidth[k];
-        level.height = kPrefilterWidth[k] / 2;
-        level.texels.resize(size_t(level.width) * size_t(level.height));
-        for (int y = 0; y < level.height; ++y) rows.push_back({k, y});
+        if ((levels >> k) & 1u) {
+            level.width = kPrefilterWidth[k];
+            level.height = kPrefilterWidth[k] / 2;
+            level.texels.resize(size_t(level.width) * size_t(level.height));
+            for (int y = 0; y < level.height; ++y) rows.push_back({k, y});
+        }
         out.push_back(std::move(level));
     }
     pool.for_each(rows.size(), [&](size_t item, int) {
@@ -311,8 +315,19 @@ std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::L
             level.texels[size_t(y) * size_t(level.width) + size_t(x)] = weight > 0.f ? sum / weight : Color(0.f);
         }
     });
-    for (EnvironmentMap::Level& level : out) set_poles(level);
+    for (EnvironmentMap::Level& level : out)
+        if (!level.texels.empty()) set_poles(level);
     return out;
+}
+
+/// The stored level pair prefiltered() blends for roughness r: level 0 alone up to the first
+/// stored roughness, else the two levels around r.
+std::pair<size_t, size_t> prefilter_pair(float roughness) {
+    const float r = std::isfinite(roughness) ? std::clamp(roughness, 0.f, 1.f) : 1.f;
+    if (r <= kPrefilterRoughness.front()) return {0, 0};
+    size_t k = 1;
+    while (k + 1 < kPrefilterRoughness.size() && r > kPrefilterRoughness[k]) ++k;
+    return {k - 1, k};
 }
 
 }  // namespace
@@ -403,7 +418,15 @@ Light to_directional_light(const ExtractedLight& light, const std::string& name)
 
 EnvironmentMap::EnvironmentMap(const Environment& env, int threads) : EnvironmentMap(env, threads, Use::Rendering) {}
 
-EnvironmentMap::EnvironmentMap(const Environment& env, int threads, Use use) {
+uint32_t prefilter_levels_read(float lo, float hi) {
+    const size_t first = prefilter_pair(std::isfinite(lo) ? std::min(lo, hi) : lo).first;
+    const size_t last = prefilter_pair(std::isfinite(hi) ? std::max(lo, hi) : hi).second;
+    uint32_t mask = 0;
+    for (size_t k = std::min(first, last); k <= std::max(first, last); ++k) mask |= 1u << k;
+    return mask;
+}
+
+EnvironmentMap::EnvironmentMap(const Environment& env, int threads, Use use, uint32_t levels) {
     if (!env.image || env.image->width < 1 || env.image->height < 1 ||
         env.image->texels.size() != size_t(env.image->width) * size_t(env.image->height))
         throw Error(fmt::format("environment map '{}' has no texels", env.image ? env.image->name : std::string()));
@@ -454,9 +477,10 @@ EnvironmentMap::EnvironmentMap(const Environment& env, int threads, Use use) {
 
     // The GGX prefilter of the map and of the residual (not needed to split the light).
     if (use == Use::SplitOnly) return;
+    if ((levels & kAllPrefilterLevels) == 0) return;
     WorkerPool pool(threads);
-    m_prefiltered = prefilter(m_levels, pool);
-    if (!m_residual.empty()) m_residual_prefiltered = prefilter(m_residual, pool);
+    m_prefiltered = prefilter(m_levels, levels, pool);
+    if (!m_residual.empty()) m_residual_prefiltered = prefilter(m_residual, levels, pool);
 }
 
 Vec3f EnvironmentMap::world_from_map(const Vec3f& d) const {
@@ -495,13 +519,14 @@ Color EnvironmentMap::lookup_prefiltered(const std::vector<Level>& pyramid, cons
     const Vec3f d = map_from_world(dir);
     const Vec2f uv = latlong_uv(d);
     const float r = std::isfinite(roughness) ? std::clamp(roughness, 0.f, 1.f) : 1.f;
-    if (r <= kPrefilterRoughness.front())
+    const auto [lo, hi] = prefilter_pair(r);
+    // A level the analysis left out is a bug (prefilter_levels_read), never a black reflection.
+    RT_CHECK(!prefiltered[lo].texels.empty() && !prefiltered[hi].texels.empty());
+    if (lo == hi)
         return lerp(pyramid.front().bilinear(uv.x, uv.y), prefiltered.front().bilinear(uv.x, uv.y),
                     r / kPrefilterRoughness.front());
-    size_t k = 1;
-    while (k + 1 < kPrefilterRoughness.size() && r > kPrefilterRoughness[k]) ++k;
-    const float f = (r - kPrefilterRoughness[k - 1]) / (kPrefilterRoughness[k] - kPrefilterRoughness[k - 1]);
-    return lerp(prefiltered[k - 1].bilinear(uv.x, uv.y), prefiltered[k].bilinear(uv.x, uv.y), std::clamp(f, 0.f, 1.f));
+    const float f = (r - kPrefilterRoughness[lo]) / (kPrefilterRoughness[hi] - kPrefilterRoughness[lo]);
+    return lerp(prefiltered[lo].bilinear(uv.x, uv.y), prefiltered[hi].bilinear(uv.x, uv.y), std::clamp(f, 0.f, 1.f));
 }
 
 EnvironmentLighting EnvironmentMap::split(const SplitSettings& settings) const {

@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -98,6 +99,13 @@ struct SplitSettings {
 /// intensity / max component, intensity its max component, no attenuation.
 Light to_directional_light(const ExtractedLight& light, const std::string& name);
 
+/// Every prefiltered level (bit k = kPrefilterRoughness[k]).
+inline constexpr uint32_t kAllPrefilterLevels = (1u << kPrefilterRoughness.size()) - 1u;
+
+/// The prefiltered levels that EnvironmentMap::prefiltered() reads for any roughness in
+/// [lo, hi] (clamped to [0, 1]; NaN reads as 1, as the lookup does).
+uint32_t prefilter_levels_read(float lo, float hi);
+
 class EnvironmentMap {
 public:
     /// Applies 2^exposure_stops, builds the MIP pyramid and the prefiltered levels, and the same for
@@ -108,7 +116,10 @@ public:
     /// What a map is built for: rendering (every lookup), or only split() (no prefiltered levels:
     /// prefiltered() and residual_prefiltered() must not be called).
     enum class Use { Rendering, SplitOnly };
-    EnvironmentMap(const Environment& env, int threads, Use use);
+    /// `levels`: bit k set = prefilter level k (kPrefilterRoughness[k]) is built; the others stay
+    /// empty (prefilter_levels_read tells which levels a range of roughness reads; the scene
+    /// analysis ORs them over the materials, so a render builds only what it looks up).
+    EnvironmentMap(const Environment& env, int threads, Use use, uint32_t levels = kAllPrefilterLevels);
 
     /// Radiance arriving from world direction `dir` (any length; non-finite gives 0), filtered
     /// over a cone of full apex angle `cone_angle` radians: trilinear between MIP levels of the

@@ -1,6 +1,7 @@
 // Scene analysis at load: per-material features, their OR over the scene, and which lights can
 // reach which objects (range window, spot cone). See scene_analysis.h for the contracts.
 #include "shading/scene_analysis.h"
+#include "shading/environment_map.h"
 
 #include <algorithm>
 #include <cmath>
@@ -61,6 +62,17 @@ MaterialFeatures material_features(const Material& m, const MappingOptions& mapp
     f.emissive = !is_black(m.emissive) && m.emissive_strength > 0.f;
     f.volume = f.transmission && m.has_volume && m.thickness > 0.f && !is_black(f.constant.absorption);
     return f;
+}
+
+/// The prefiltered environment levels the glossy term of a material can read: classic materials
+/// have constant kg and roughness; glTF ones roughness = factor x texture (<= factor), and a
+/// textured one may have kg > 0 where its factors give 0.
+uint32_t glossy_levels(const Material& m, const MaterialFeatures& f) {
+    if (m.model == MaterialModel::Classic)
+        return is_black(f.constant.kg) ? 0u : prefilter_levels_read(f.constant.roughness, f.constant.roughness);
+    if (m.unlit || (is_black(f.constant.kg) && !f.textured)) return 0u;
+    const float r = std::clamp(m.roughness, 0.f, 1.f);
+    return prefilter_levels_read(m.metallic_roughness_texture.valid() ? 0.f : r, r);
 }
 
 /// Smallest distance from p to the box b (0 inside).
@@ -169,6 +181,8 @@ SceneAnalysis analyze_scene(const Scene& scene, const MappingOptions& mapping) {
         f.varying = f.textured || f.vertex_colors;
         if (f.used) s |= f;
     }
+    for (size_t i = 0; i < a.materials.size(); ++i)
+        if (a.materials[i].used) a.prefilter_levels |= glossy_levels(scene.materials[i], a.materials[i]);
 
     // Light reach per object: instances (transformed mesh bounds), spheres, planes.
     std::vector<Bounds3d> mesh_bounds(scene.meshes.size());

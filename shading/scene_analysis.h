@@ -96,7 +96,9 @@ struct SceneAnalysis {
     size_t triangles = 0;                     ///< instanced triangles
     size_t spheres = 0;                       ///< analytic spheres
     size_t sphere_bytes = 0;                  ///< their records (Scene::spheres, names included)
-
+    /// The environment's prefiltered levels (bit k: kPrefilterRoughness[k]) that the used
+    /// materials' glossy term kg G can read; a render builds only these (EnvironmentMap).
+    uint32_t prefilter_levels = 0;
     /// The lights that may reach object `o`, in ascending order (the order of Scene::lights).
     std::span<const uint32_t> lights_of(uint32_t o) const {
         return {light_indices.data() + light_offsets[o], light_indices.data() + light_offsets[o + 1]};

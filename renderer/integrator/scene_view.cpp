@@ -69,7 +69,10 @@ constexpr float kNoFootprint[2] = {-kInfinity, -kInfinity};
 
 SceneView::SceneView(const Scene& scene, const MappingOptions& mapping)
     : m_scene(scene), m_mapping(mapping), m_analysis(analyze_scene(scene, mapping)) {
-    if (scene.environment) m_environment = std::make_shared<const EnvironmentMap>(*scene.environment);
+    // Only the prefiltered levels the materials' glossy term reads (most of the map's build time).
+    if (scene.environment)
+        m_environment = std::make_shared<const EnvironmentMap>(*scene.environment, 0, EnvironmentMap::Use::Rendering,
+                                                               m_analysis.prefilter_levels);
     // Float transforms per instance; the normal matrix is inverted in double precision.
     m_xf.resize(scene.instances.size());
     for (size_t i = 0; i < scene.instances.size(); ++i) {

@@ -15,6 +15,8 @@
 #include <chrono>
 #include <cctype>
 #include <cmath>
+#include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -26,14 +28,14 @@
 
 #include <unistd.h>
 
+#include <Imath/half.h>
 #include <OpenColorIO/OpenColorIO.h>
-#include <OpenImageIO/half.h>
-#include <OpenImageIO/imageio.h>
 
 #include "renderer/core/data_files.h"
 #include "renderer/core/error.h"
+#include "renderer/core/image_files.h"
 #include "renderer/core/log.h"
-
+#include "renderer/output/png_encoder.h"
 namespace OCIO = OCIO_NAMESPACE;
 namespace fs = std::filesystem;
 
@@ -238,12 +240,20 @@ void validate_film(const Film& film, const std::string& path) {
     check(film.aovs.aa_samples, film.aa_samples.size(), "aa_samples");
 }
 
-/// One image ready for OIIO: its spec and pixels in `format` (TypeUnknown = native per-channel).
+/// One image ready for a writer: what it holds and its pixels, every channel in its own type.
 struct EncodedImage {
-    OIIO::ImageSpec spec;
-    OIIO::TypeDesc format = OIIO::TypeUnknown;
+    ImageDesc desc;
     std::vector<unsigned char> bytes;
 };
+
+/// The metadata entry `key` set to `value` (replaced when present, else appended).
+void set_attribute(ImageDesc& desc, const std::string& key, const std::string& value) {
+    auto it = std::find_if(desc.attributes.begin(), desc.attributes.end(), [&](const auto& a) { return a.first == key; });
+    if (it != desc.attributes.end())
+        it->second = value;
+    else
+        desc.attributes.emplace_back(key, value);
+}
 
 /// Appends the raw bytes of `value` to `out` (native layout for per-channel EXR formats).
 template <typename T>
@@ -255,50 +265,42 @@ void append_bytes(std::vector<unsigned char>& out, const T& value) {
 /// Scene-linear EXR: beauty (half or float) + AOVs, data window = film window inside the
 /// full_width x full_height display window.
 EncodedImage encode_exr(const Film& film, const OutputSettings& settings) {
-    const OIIO::TypeDesc beauty_type = settings.exr_half ? OIIO::TypeHalf : OIIO::TypeFloat;
+    const PixelType beauty_type = settings.exr_half ? PixelType::Half : PixelType::Float;
     EncodedImage image;
-    OIIO::ImageSpec& spec = image.spec;
-    spec = OIIO::ImageSpec(film.width(), film.height(), 3, beauty_type);
+    ImageDesc& desc = image.desc;
+    desc.format_name = "openexr";
+    desc.width = film.width();
+    desc.height = film.height();
 
     // Channel layout; AOVs are data, so they stay float (ids: 32-bit unsigned) in either mode.
-    std::vector<std::string> names{"R", "G", "B"};
-    std::vector<OIIO::TypeDesc> formats(3, beauty_type);
-    auto add = [&](std::initializer_list<const char*> channel_names, OIIO::TypeDesc type) {
+    auto add = [&](std::initializer_list<const char*> channel_names, PixelType type) {
         for (const char* name : channel_names) {
-            names.emplace_back(name);
-            formats.push_back(type);
+            desc.channel_names.emplace_back(name);
+            desc.channel_types.push_back(type);
         }
     };
-    if (film.aovs.depth) add({"Z"}, OIIO::TypeFloat);
-    if (film.aovs.normal) add({"N.X", "N.Y", "N.Z"}, OIIO::TypeFloat);
-    if (film.aovs.albedo) add({"albedo.R", "albedo.G", "albedo.B"}, OIIO::TypeFloat);
-    if (film.aovs.prim_id) add({"primId"}, OIIO::TypeUInt);
-    if (film.aovs.inst_id) add({"instId"}, OIIO::TypeUInt);
-    if (film.aovs.aa_samples) add({"aa.samples"}, OIIO::TypeFloat);
-
-    spec.nchannels = int(names.size());
-    spec.channelnames = names;
-    spec.alpha_channel = -1;
-    spec.z_channel = film.aovs.depth ? 3 : -1;
-    // A uniform format needs no per-channel list; otherwise `format` is the most precise one.
-    const bool mixed = std::any_of(formats.begin(), formats.end(), [&](OIIO::TypeDesc t) { return t != beauty_type; });
-    if (mixed) {
-        spec.channelformats = formats;
-        spec.format = OIIO::TypeFloat;
-    }
+    add({"R", "G", "B"}, beauty_type);
+    if (film.aovs.depth) add({"Z"}, PixelType::Float);
+    if (film.aovs.normal) add({"N.X", "N.Y", "N.Z"}, PixelType::Float);
+    if (film.aovs.albedo) add({"albedo.R", "albedo.G", "albedo.B"}, PixelType::Float);
+    if (film.aovs.prim_id) add({"primId"}, PixelType::UInt32);
+    if (film.aovs.inst_id) add({"instId"}, PixelType::UInt32);
+    if (film.aovs.aa_samples) add({"aa.samples"}, PixelType::Float);
+    desc.alpha_channel = -1;
+    desc.z_channel = film.aovs.depth ? 3 : -1;
 
     // Crop: data window inside the display window.
-    spec.x = film.window.x0;
-    spec.y = film.window.y0;
-    spec.full_x = 0;
-    spec.full_y = 0;
-    spec.full_width = film.full_width;
-    spec.full_height = film.full_height;
-    spec.attribute("compression", "zip");
+    desc.x = film.window.x0;
+    desc.y = film.window.y0;
+    desc.full_x = 0;
+    desc.full_y = 0;
+    desc.full_width = film.full_width;
+    desc.full_height = film.full_height;
+    desc.attributes.emplace_back("compression", "zip");
 
     // Pack the pixels in the file's native per-channel layout, so ids stay exact 32-bit values.
     const size_t n = film.beauty.size();
-    image.bytes.reserve(n * spec.pixel_bytes(true));
+    image.bytes.reserve(n * desc.pixel_bytes());
     for (size_t i = 0; i < n; ++i) {
         const Color& c = film.beauty[i];
         for (float v : {c.x, c.y, c.z}) {
@@ -320,8 +322,7 @@ EncodedImage encode_exr(const Film& film, const OutputSettings& settings) {
         if (film.aovs.inst_id) append_bytes(image.bytes, film.inst_id[i]);
         if (film.aovs.aa_samples) append_bytes(image.bytes, film.aa_samples[i]);
     }
-    RT_CHECK_EQ(image.bytes.size(), n * spec.pixel_bytes(true));
-    image.format = OIIO::TypeUnknown;
+    RT_CHECK_EQ(image.bytes.size(), n * desc.pixel_bytes());
     return image;
 }
 
@@ -335,8 +336,12 @@ EncodedImage encode_display(const Film& film, FileKind kind, const OutputSetting
     if (bits == 16 && kind == FileKind::Jpeg) throw Error(fmt::format("{}: JPEG supports only 8 bits", path));
 
     EncodedImage image;
-    image.format = bits == 16 ? OIIO::TypeUInt16 : OIIO::TypeUInt8;
-    image.spec = OIIO::ImageSpec(film.width(), film.height(), 3, image.format);
+    ImageDesc& desc = image.desc;
+    desc.format_name = oiio_format_name(kind);
+    desc.width = film.width();
+    desc.height = film.height();
+    desc.channel_names = {"R", "G", "B"};
+    desc.channel_types.assign(3, bits == 16 ? PixelType::UInt16 : PixelType::UInt8);
     image.bytes.resize(film.beauty.size() * 3 * (bits == 16 ? 2 : 1));
     std::optional<DisplayTransform> transform;
     try {
@@ -346,9 +351,9 @@ EncodedImage encode_display(const Film& film, FileKind kind, const OutputSetting
         throw Error(fmt::format("{}: {}", path, e.what()));
     }
 
-    if (kind == FileKind::Tiff) image.spec.attribute("compression", "zip");
-    image.spec.attribute("whitted:display", transform->display());
-    image.spec.attribute("whitted:view", transform->view());
+    if (kind == FileKind::Tiff) desc.attributes.emplace_back("compression", "zip");
+    desc.attributes.emplace_back("whitted:display", transform->display());
+    desc.attributes.emplace_back("whitted:view", transform->view());
     return image;
 }
 
@@ -397,7 +402,14 @@ private:
 
 /// Writes `image` to "<dir>/.<stem>.tmp-<pid><ext>" and renames it to `path`; on any failure
 /// (including exceptions) the temporary file is removed; errors are whitted::Error("<path>: <reason>").
-void write_atomically(const EncodedImage& image, FileKind kind, const fs::path& path) {
+/// Test hook: holds the half-written temporary file for a while, so the CLI tests can interrupt
+/// a write in progress (tests/cli/test_cli.cpp). Unset in normal use.
+void test_write_delay() {
+    if (const char* delay = std::getenv("WHITTED_TEST_WRITE_DELAY_MS"))
+        std::this_thread::sleep_for(std::chrono::milliseconds(std::clamp(std::atol(delay), 0L, 60000L)));
+}
+
+void write_atomically(const EncodedImage& image, const fs::path& path) {
     const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
     std::error_code ec;
     if (!fs::is_directory(dir, ec))
@@ -407,22 +419,29 @@ void write_atomically(const EncodedImage& image, FileKind kind, const fs::path& 
     // The real extension stays last so that every tool recognises the temporary file's format.
     TempFileGuard temp(dir / fmt::format(".{}.tmp-{}{}", path.stem().string(), long(::getpid()),
                                          path.extension().string()));
-    {
-        auto out = OIIO::ImageOutput::create(oiio_format_name(kind));
-        if (!out) throw fail(OIIO::geterror());
-        if (!out->open(temp.path().string(), image.spec)) throw fail(out->geterror());
-        // Test hook: hold the half-written temporary file for a while, so the CLI tests can
-        // interrupt a write in progress (tests/cli/test_cli.cpp). Unset in normal use.
-        if (const char* delay = std::getenv("WHITTED_TEST_WRITE_DELAY_MS"))
-            std::this_thread::sleep_for(std::chrono::milliseconds(std::clamp(std::atol(delay), 0L, 60000L)));
-        if (!out->write_image(image.format, image.bytes.data())) {
-            std::string reason = out->geterror();
-            out->close();
-            throw fail(reason);
+    if (image.desc.format_name == "png") {
+        // PNG is encoded in house (png_encoder.h): OIIO is not even loaded.
+        const int bits = image.desc.channel_types.front() == PixelType::UInt16 ? 16 : 8;
+        std::vector<uint8_t> png;
+        try {
+            png = encode_png(image.bytes, image.desc.width, image.desc.height, bits, image.desc.attributes);
+        } catch (const Error& e) {
+            throw fail(e.what());
         }
-        if (!out->close()) throw fail(out->geterror());
+        std::FILE* f = std::fopen(temp.path().c_str(), "wb");
+        if (!f) throw fail(fmt::format("cannot create '{}': {}", temp.path().string(), std::strerror(errno)));
+        test_write_delay();
+        const bool written = std::fwrite(png.data(), 1, png.size(), f) == png.size();
+        const int saved = errno;
+        if (std::fclose(f) != 0 || !written)
+            throw fail(fmt::format("cannot write '{}': {}", temp.path().string(), std::strerror(written ? errno : saved)));
+    } else {
+        try {
+            write_image_file(temp.path().string(), image.desc, image.bytes.data(), test_write_delay);
+        } catch (const Error& e) {
+            throw fail(e.what());
+        }
     }
-
     fs::rename(temp.path(), path, ec);
     if (ec) throw fail(fmt::format("cannot rename '{}': {}", temp.path().string(), ec.message()));
     temp.release();
@@ -458,27 +477,40 @@ void write_image(const Film& film, const std::string& path, const OutputSettings
         *kind == FileKind::Exr ? encode_exr(film, settings) : encode_display(film, *kind, settings, path);
     // Metadata as string attributes: EXR header attributes, PNG text chunks, TIFF/JPEG where
     // the format has a place for them (OIIO drops the rest). The caller's keys win.
-    image.spec.attribute("Software", "whitted " WHITTED_VERSION);
-    for (const auto& [key, value] : settings.metadata) image.spec.attribute(key, value);
+    set_attribute(image.desc, "Software", "whitted " WHITTED_VERSION);
+    for (const auto& [key, value] : settings.metadata) set_attribute(image.desc, key, value);
 
-    write_atomically(image, *kind, file);
-    log_debug("wrote {} ({}x{}, {} channels)", path, image.spec.width, image.spec.height, image.spec.nchannels);
+    write_atomically(image, file);
+    log_debug("wrote {} ({}x{}, {} channels)", path, image.desc.width, image.desc.height, image.desc.channels());
 }
 
+namespace {
+
+/// open_image_file with the path in its errors ("<path>: <prefix><reason>").
+std::unique_ptr<ImageFileReader> open_for_reading(const std::string& path, const char* prefix) {
+    try {
+        return open_image_file(path);
+    } catch (const Error& e) {
+        throw Error(fmt::format("{}: {}{}", path, prefix, e.what()));
+    }
+}
+
+}  // namespace
+
 std::vector<float> read_image_rgb(const std::string& path, int& width, int& height) {
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw Error(fmt::format("{}: {}", path, OIIO::geterror()));
-    const OIIO::ImageSpec& spec = in->spec();
+    std::unique_ptr<ImageFileReader> in = open_for_reading(path, "");
+    const ImageDesc& spec = in->desc();
     width = spec.width;
     height = spec.height;
     const size_t n = size_t(width) * size_t(height);
 
     // The first three channels; a one- or two-channel (grey, grey + alpha) image repeats grey.
-    const int channels = std::min(spec.nchannels, 3);
+    const int channels = std::min(spec.channels(), 3);
     std::vector<float> read(n * size_t(channels));
-    if (!in->read_image(0, 0, 0, channels, OIIO::TypeFloat, read.data())) {
-        std::string reason = in->geterror();
-        throw Error(fmt::format("{}: {}", path, reason));
+    try {
+        in->read(0, channels, PixelType::Float, read.data());
+    } catch (const Error& e) {
+        throw Error(fmt::format("{}: {}", path, e.what()));
     }
     if (channels == 3) return read;
     std::vector<float> rgb(n * 3);
@@ -488,13 +520,12 @@ std::vector<float> read_image_rgb(const std::string& path, int& width, int& heig
 }
 
 Film read_film(const std::string& path, std::map<std::string, std::string>* metadata) {
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw Error(fmt::format("{}: cannot read: {}", path, OIIO::geterror()));
-    const OIIO::ImageSpec& spec = in->spec();
-    if (std::string_view(in->format_name()) != "openexr") throw Error(fmt::format("{}: not an EXR file", path));
+    std::unique_ptr<ImageFileReader> in = open_for_reading(path, "cannot read: ");
+    const ImageDesc& spec = in->desc();
+    if (spec.format_name != "openexr") throw Error(fmt::format("{}: not an EXR file", path));
     auto channel = [&](std::string_view name) {
-        for (int c = 0; c < spec.nchannels; ++c)
-            if (spec.channelnames[size_t(c)] == name) return c;
+        for (int c = 0; c < spec.channels(); ++c)
+            if (spec.channel_names[size_t(c)] == name) return c;
         return -1;
     };
     const int r = channel("R"), g = channel("G"), b = channel("B");
@@ -514,13 +545,16 @@ Film read_film(const std::string& path, std::map<std::string, std::string>* meta
     Film film(spec.full_width, spec.full_height, window, aovs);
     const size_t n = film.beauty.size();
     // Channel by channel as float; the ids as 32-bit unsigned, exactly.
-    auto read_channel = [&](int c, OIIO::TypeDesc type, void* out) {
-        if (!in->read_image(0, 0, c, c + 1, type, out))
-            throw Error(fmt::format("{}: {}", path, in->geterror()));
+    auto read_channel = [&](int c, PixelType type, void* out) {
+        try {
+            in->read(c, c + 1, type, out);
+        } catch (const Error& e) {
+            throw Error(fmt::format("{}: {}", path, e.what()));
+        }
     };
     std::vector<float> plane(n);
     auto read_into = [&](int c, auto&& store) {
-        read_channel(c, OIIO::TypeFloat, plane.data());
+        read_channel(c, PixelType::Float, plane.data());
         for (size_t i = 0; i < n; ++i) store(i, plane[i]);
     };
     read_into(r, [&](size_t i, float v) { film.beauty[i].x = v; });
@@ -537,13 +571,12 @@ Film read_film(const std::string& path, std::map<std::string, std::string>* meta
         read_into(channel("albedo.G"), [&](size_t i, float v) { film.albedo[i].y = v; });
         read_into(channel("albedo.B"), [&](size_t i, float v) { film.albedo[i].z = v; });
     }
-    if (aovs.prim_id) read_channel(channel("primId"), OIIO::TypeUInt, film.prim_id.data());
-    if (aovs.inst_id) read_channel(channel("instId"), OIIO::TypeUInt, film.inst_id.data());
+    if (aovs.prim_id) read_channel(channel("primId"), PixelType::UInt32, film.prim_id.data());
+    if (aovs.inst_id) read_channel(channel("instId"), PixelType::UInt32, film.inst_id.data());
     if (aovs.aa_samples) read_into(channel("aa.samples"), [&](size_t i, float v) { film.aa_samples[i] = v; });
     if (metadata) {
         metadata->clear();
-        for (const OIIO::ParamValue& p : spec.extra_attribs)
-            if (p.type() == OIIO::TypeString) (*metadata)[p.name().string()] = p.get_string();
+        for (const auto& [key, value] : spec.attributes) (*metadata)[key] = value;
     }
     return film;
 }

@@ -8,7 +8,8 @@ if(rc)
   message(FATAL_ERROR "cmake --install failed: ${rc}")
 endif()
 foreach(f include/whitted/whitted.h lib/cmake/whitted/whittedConfig.cmake lib/cmake/whitted/whittedConfigVersion.cmake
-          bin/whitted share/whitted/ocio/config.ocio share/whitted/environments/studio.exr)
+          bin/whitted share/whitted/ocio/config.ocio share/whitted/environments/studio.exr
+          lib/whitted/libwhitted_oiio.so)
   if(NOT EXISTS "${WORK_DIR}/prefix/${f}")
     message(FATAL_ERROR "not installed: ${f}")
   endif()
@@ -32,6 +33,12 @@ if(rc)
 endif()
 if(NOT out MATCHES "OCIO config: ${WORK_DIR}/prefix/share/whitted/ocio/config.ocio")
   message(FATAL_ERROR "the installed library did not find its own data in the prefix")
+endif()
+# A JPEG goes through the image module (OpenImageIO), installed beside the library.
+execute_process(COMMAND ${CMAKE_COMMAND} -E env WHITTED_DATA_DIR= WHITTED_IMAGE_MODULE=${WORK_DIR}/prefix/lib/whitted/libwhitted_oiio.so
+                        "${WORK_DIR}/build/consumer" "${SCENE}" "${WORK_DIR}/out.jpg" RESULT_VARIABLE rc OUTPUT_QUIET)
+if(rc OR NOT EXISTS "${WORK_DIR}/out.jpg")
+  message(FATAL_ERROR "the consumer could not write a JPEG through the installed image module: ${rc}")
 endif()
 # The Python module from the prefix (when it was built): imports, renders, finds its data there.
 if(PYTHON)

@@ -12,6 +12,7 @@
 #include "importers/scene_loader.h"
 #include "renderer/integrator/render.h"
 #include "renderer/scene/scene_builder.h"
+#include "shading/environment_map.h"
 #include "shading/scene_analysis.h"
 
 namespace whitted {
@@ -296,6 +297,29 @@ TEST(Specialization, LightCullingNeverChangesTheImage) {
 }
 
 // ---- analysis flags on chosen assets ----
+
+// The environment's prefiltered levels a render builds: those the used materials' roughness
+// reads. Box (untextured, roughness 1) reads the two roughest; a material with a
+// metallic-roughness texture can reach roughness 0, so all up to its factor; classic
+// materials without a glossy term none.
+TEST(SceneAnalysis, PrefilterLevelsFollowTheMaterials) {
+    EXPECT_EQ(analyze_scene(load_scene(kAssets + "/gltf/Box/glTF-Binary/Box.glb")).prefilter_levels,
+              prefilter_levels_read(1.f, 1.f));
+    EXPECT_EQ(analyze_scene(load_scene(kAssets + "/scenes/whitted1980.json")).prefilter_levels, 0u);
+    Scene s;
+    Material textured;
+    textured.roughness = 0.6f;
+    textured.metallic_roughness_texture.texture = 0;
+    Material smooth;
+    smooth.roughness = 0.1f;
+    Material unused;
+    unused.roughness = 0.9f;
+    add_mesh(s, make_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, add_gltf_material(s, textured)));
+    add_mesh(s, make_quad({0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}, add_gltf_material(s, smooth)));
+    add_gltf_material(s, unused);
+    EXPECT_EQ(analyze_scene(s).prefilter_levels, prefilter_levels_read(0.f, 0.6f) | prefilter_levels_read(0.1f, 0.1f));
+    EXPECT_EQ(analyze_scene(s).prefilter_levels, 0b0111u);
+}
 
 TEST(SceneAnalysis, FlagsOfBundledScenes) {
     {

@@ -399,6 +399,32 @@ TEST(Environment, SameResultForAnyThreadCount) {
         for (float r : {0.3f, 0.5f, 0.9f}) ASSERT_EQ(one.prefiltered(d, r), two.prefiltered(d, r));
 }
 
+// A render builds only the prefiltered levels its materials read: each roughness range reads
+// exactly the levels prefilter_levels_read names, with the same values as a map holding all
+// of them (bit for bit), and reading a level left out is an error, never a black reflection.
+TEST(Environment, OnlyTheLevelsTheRoughnessReadsAreBuilt) {
+    EXPECT_EQ(prefilter_levels_read(0.f, 0.f), 0b0001u);
+    EXPECT_EQ(prefilter_levels_read(0.25f, 0.25f), 0b0001u);
+    EXPECT_EQ(prefilter_levels_read(0.3f, 0.3f), 0b0011u);
+    EXPECT_EQ(prefilter_levels_read(1.f, 1.f), 0b1100u);
+    EXPECT_EQ(prefilter_levels_read(0.f, 1.f), kAllPrefilterLevels);
+    EXPECT_EQ(prefilter_levels_read(0.6f, 0.4f), 0b0111u);
+    EXPECT_EQ(prefilter_levels_read(std::nanf(""), std::nanf("")), 0b1100u);
+    const Environment env = bundled("sunset");
+    const EnvironmentMap all(env, 2);
+    for (float r : {0.f, 0.1f, 0.25f, 0.4f, 0.5f, 0.7f, 0.9f, 1.f}) {
+        const uint32_t levels = prefilter_levels_read(r, r);
+        const EnvironmentMap some(env, 2, EnvironmentMap::Use::Rendering, levels);
+        EXPECT_LT(some.bytes(), all.bytes()) << r;
+        for (const Vec3f& d : random_directions(200, 5)) {
+            ASSERT_EQ(some.prefiltered(d, r), all.prefiltered(d, r)) << r;
+            ASSERT_EQ(some.residual_prefiltered(d, r), all.residual_prefiltered(d, r)) << r;
+        }
+        const float other = r <= 0.5f ? 1.f : 0.f;  // reads levels this map lacks
+        EXPECT_THROW(some.prefiltered(random_directions(1, 1)[0], other), Error) << r;
+    }
+}
+
 // The memory a built map reports stays within the estimate that --max-memory is checked against
 // (the build and split times are figures of docs/measurements/environment.md, not asserted).
 TEST(Environment, MemoryWithinEstimate) {
