@@ -21,6 +21,8 @@ Command register_bench_aa(CLI::App& bench);
 Command register_bench_accel(CLI::App& bench);
 /// `whitted bench env`: display error and time of N lights extracted from an environment (bench_env.cpp).
 Command register_bench_env(CLI::App& bench);
+/// `whitted bench process`: whole runs, start to file written, with their split (bench_process.cpp).
+Command register_bench_process(CLI::App& bench);
 /// `whitted bench scale`: load/build/render time and memory per object against object count (bench_scale.cpp).
 Command register_bench_scale(CLI::App& bench);
 /// `whitted bench skip`: what specialised kernels and skipped rays save (bench_skip.cpp).

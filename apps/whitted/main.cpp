@@ -556,6 +556,7 @@ int main(int argc, char** argv) {
     commands.push_back(app::register_bench_aa(*bench));
     commands.push_back(app::register_bench_accel(*bench));
     commands.push_back(app::register_bench_env(*bench));
+    commands.push_back(app::register_bench_process(*bench));
     commands.push_back(app::register_bench_scale(*bench));
     commands.push_back(app::register_bench_skip(*bench));
     commands.push_back(app::register_bench_stability(*bench));

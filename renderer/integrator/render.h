@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <chrono>
 #include <memory>
 #include <optional>
 #include <string>
@@ -26,7 +27,7 @@ namespace whitted {
 constexpr int kMaxTreeDepth = 1024;
 
 struct RenderStats {
-    double build_seconds = 0.0;           ///< accelerator build
+    double build_seconds = 0.0;           ///< scene view (analysis, environment map) and accelerator build
     double render_seconds = 0.0;          ///< tracing all tiles
     RayCounters rays;
     uint64_t nonfinite_samples = 0;       ///< samples that were NaN/inf and were replaced by 0
@@ -102,6 +103,8 @@ private:
     RenderSettings m_settings;
     ImageSize m_size;
     PixelWindow m_window;
+    /// When construction began (before m_view: the environment map's build counts as build time).
+    std::chrono::steady_clock::time_point m_started = std::chrono::steady_clock::now();
     SceneView m_view;
     std::unique_ptr<Accelerator> m_accel;
     double m_build_seconds = 0.0;
