@@ -1,6 +1,7 @@
 """The Python module against the library and the CLI (docs/python.md). Run by ctest (label python):
 PYTHONPATH=build/release/python /usr/bin/python3 -m pytest python/tests"""
 import os
+import sys
 import subprocess
 
 import numpy as np
@@ -145,3 +146,20 @@ def test_wrong_shapes_and_dtypes_raise_value_error_naming_the_argument(glb):
         glb.intersect(d, d, kind="sideways")
     with pytest.raises(whitted.Error, match="accelerator|unknown"):
         glb.intersect(d, d, accel="quadtree")
+
+
+def test_import_render_and_png_do_not_load_openimageio(tmp_path):
+    # A fresh interpreter: importing whitted, rendering with the bundled environment and writing a
+    # PNG and an EXR never map OpenImageIO (docs/performance.md "Fixed cost of a run"); a JPEG does.
+    code = (
+        "import sys, whitted\n"
+        "img = whitted.render(whitted.load(sys.argv[1]), width=16)\n"
+        "whitted.write(img, sys.argv[2] + '/a.png'); whitted.write(img, sys.argv[2] + '/a.exr')\n"
+        "before = 'libOpenImageIO' in open('/proc/self/maps').read()\n"
+        "whitted.write(img, sys.argv[2] + '/a.jpg')\n"
+        "print(before, 'libOpenImageIO' in open('/proc/self/maps').read())\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code, DEFAULT_GLB, str(tmp_path)], capture_output=True, text=True,
+                         env=dict(os.environ), check=True).stdout.split()
+    assert out == ["False", "True"]
+    assert (tmp_path / "a.png").stat().st_size > 0 and (tmp_path / "a.jpg").stat().st_size > 0

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <fstream>
@@ -187,10 +188,17 @@ void write_exr_file(const std::string& path, const ImageDesc& desc, const void* 
     const Imath::Box2i display(Imath::V2i(desc.full_x, desc.full_y), Imath::V2i(desc.full_x + fw - 1, desc.full_y + fh - 1));
     try {
         Imf::Header header(display, data);
-        header.compression() = compression_from(desc.attribute("compression"));
-        // zlib level 3: measured on a 1920x1080 half beauty, 50 ms and 903 KB against OpenEXR's
-        // default 4 (62 ms, 831 KB) and 6 (93 ms, 759 KB) (docs/measurements/performance.md).
+        // "zip" or "zip:N" (OIIO's spelling of a zlib level). Level 3 by default: measured on a
+        // 1920x1080 half beauty, 50 ms and 903 KB against OpenEXR's default 4 (62 ms, 831 KB) and
+        // 6 (93 ms, 759 KB) (benchmarks/bench_output.cpp, docs/measurements/performance.md).
+        const std::string compression = desc.attribute("compression");
+        const size_t colon = compression.find(':');
+        header.compression() = compression_from(compression.substr(0, colon));
         header.zipCompressionLevel() = 3;
+        if (colon != std::string::npos) {
+            const int level = std::atoi(compression.c_str() + colon + 1);
+            if (level >= 1 && level <= 9) header.zipCompressionLevel() = level;
+        }
         for (const auto& [key, value] : desc.attributes)
             if (key != "compression") header.insert(key, Imf::StringAttribute(value));
         const size_t pixel = desc.pixel_bytes();
