@@ -113,7 +113,11 @@ std::unique_ptr<Accelerator> create_backend(const std::string& name, const Scene
             if (*k == "0" || *k == "1") c.compact = *k == "1";
             else throw Error(fmt::format("accelerator '{}': compact must be 0 or 1", name));
         }
-        spec.check_all_used("packet, compact");
+        if (const std::string* f = spec.find("flatten")) {
+            if (*f == "0" || *f == "1") c.flatten = *f == "1";
+            else throw Error(fmt::format("accelerator '{}': flatten must be 0 or 1", name));
+        }
+        spec.check_all_used("packet, compact, flatten");
         return create_embree_accelerator(scene, filter, c);
     }
     if (spec.name() == "bvh") {

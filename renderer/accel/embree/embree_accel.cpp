@@ -93,6 +93,8 @@ Hit hit_from_filter_args(const RTCFilterFunctionNArguments* args, unsigned i, co
     h.v = RTCHitN_v(args->hit, args->N, i);
     h.prim = RTCHitN_primID(args->hit, args->N, i);
     h.inst = RTCHitN_instID(args->hit, args->N, i, 0);
+    // A flattened mesh sits in the top-level scene, its geometry ID the instance's index.
+    if (h.inst == RTC_INVALID_GEOMETRY_ID) h.inst = RTCHitN_geomID(args->hit, args->N, i);
     h.geom = (*q.mesh_of_instance)[h.inst];
     return h;
 }
@@ -266,11 +268,27 @@ public:
         const RTCSceneFlags flags = RTCSceneFlags((config.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE) |
                                                   (config.compact ? RTC_SCENE_FLAG_COMPACT : RTC_SCENE_FLAG_NONE));
 
-        // One Embree scene per mesh, geometry ID 0 inside it.
+        // Which meshes are flattened: used by exactly one instance whose transform keeps the
+        // orientation (a mirroring one would flip the winding Embree's Ng follows).
+        std::vector<uint32_t> uses(scene.meshes.size(), 0);
+        for (const Instance& inst : scene.instances)
+            if (inst.mesh < uses.size()) ++uses[inst.mesh];
+        std::vector<int64_t> flat_instance(scene.meshes.size(), -1);  ///< the instance a flattened mesh is placed by
+        if (config.flatten)
+            for (size_t i = 0; i < scene.instances.size(); ++i) {
+                const Instance& inst = scene.instances[i];
+                if (inst.mesh < uses.size() && uses[inst.mesh] == 1 && inst.world_from_object.det3() > 0.0)
+                    flat_instance[inst.mesh] = int64_t(i);
+            }
+
+        // One Embree scene per instanced mesh (geometry ID 0 inside it); flattened meshes are
+        // built in world space and attached to the top level below.
+        m_top = rtcNewScene(m_device);
         m_mesh_scenes.assign(scene.meshes.size(), nullptr);
         for (size_t m = 0; m < scene.meshes.size(); ++m) {
             const Mesh& mesh = scene.meshes[m];
             if (mesh.triangle_count() == 0) continue;
+            const Mat4d* to_world = flat_instance[m] >= 0 ? &scene.instances[size_t(flat_instance[m])].world_from_object : nullptr;
             RTCGeometry g = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_TRIANGLE);
             // Vertex buffer with explicit tail padding (kVertexPadding), zero-filled.
             const size_t vertex_bytes = mesh.positions.size() * 3 * sizeof(float);
@@ -293,9 +311,11 @@ public:
                 throw Error("Embree: cannot allocate geometry buffers");
             }
             for (size_t i = 0; i < mesh.positions.size(); ++i) {
-                v[3 * i + 0] = mesh.positions[i].x;
-                v[3 * i + 1] = mesh.positions[i].y;
-                v[3 * i + 2] = mesh.positions[i].z;
+                Vec3f p = mesh.positions[i];
+                if (to_world) p = Vec3f(to_world->apply_point(Vec3d(p)));  // double, rounded once
+                v[3 * i + 0] = p.x;
+                v[3 * i + 1] = p.y;
+                v[3 * i + 2] = p.z;
             }
             const uint32_t needs = filter.mesh_flags(uint32_t(m));
             if (needs & SurfaceFilter::kNeedsAccept) rtcSetGeometryIntersectFilterFunction(g, &intersect_filter);
@@ -303,6 +323,12 @@ public:
             // mesh gets a filter-free rtcOccluded.
             if (needs & SurfaceFilter::kNeedsTransmittance) rtcSetGeometryOccludedFilterFunction(g, &occluded_filter);
             rtcCommitGeometry(g);
+            if (to_world) {
+                rtcAttachGeometryByID(m_top, g, unsigned(flat_instance[m]));  // geometry ID = instance index
+                rtcReleaseGeometry(g);
+                ++m_flattened;
+                continue;
+            }
             RTCScene s = rtcNewScene(m_device);
             rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_MEDIUM);
             rtcSetSceneFlags(s, flags);
@@ -312,16 +338,16 @@ public:
             m_mesh_scenes[m] = s;
         }
 
-        // The top level: one instance per Instance, geometry ID = instance index.
-        m_top = rtcNewScene(m_device);
+        // The top level: one instance per Instance, geometry ID = instance index (a flattened
+        // mesh's triangles already hold that ID).
         rtcSetSceneBuildQuality(m_top, RTC_BUILD_QUALITY_MEDIUM);
         rtcSetSceneFlags(m_top, flags);
         m_mesh_of_instance.resize(scene.instances.size());
         for (size_t i = 0; i < scene.instances.size(); ++i) {
             const Instance& inst = scene.instances[i];
             m_mesh_of_instance[i] = inst.mesh;
-            RTCScene child = m_mesh_scenes[inst.mesh];
-            if (!child) continue;
+            RTCScene child = inst.mesh < m_mesh_scenes.size() ? m_mesh_scenes[inst.mesh] : nullptr;
+            if (!child) continue;  // empty or flattened
             RTCGeometry g = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_INSTANCE);
             rtcSetGeometryInstancedScene(g, child);
             float xfm[12];
@@ -429,7 +455,7 @@ private:
         h.u = u;
         h.v = v;
         h.prim = prim_id;
-        h.inst = inst_id;
+        h.inst = inst_id != RTC_INVALID_GEOMETRY_ID ? inst_id : geom_id;  // flattened: geometry ID = instance
         h.geom = m_mesh_of_instance[h.inst];
         return h;
     }
@@ -483,6 +509,7 @@ private:
     RTCScene m_top = nullptr;
     std::vector<RTCScene> m_mesh_scenes;
     std::vector<uint32_t> m_mesh_of_instance;
+    size_t m_flattened = 0;  ///< meshes placed in the top level in world space (EmbreeConfig::flatten)
     SpherePrims<float> m_spheres;                         ///< user data of the sphere geometry
     unsigned m_sphere_geom_id = RTC_INVALID_GEOMETRY_ID;  ///< its geometry ID in m_top
     std::mutex m_error_mutex;
