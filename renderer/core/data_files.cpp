@@ -37,6 +37,8 @@ fs::path executable_dir() {
 
 }  // namespace
 
+std::string whitted_binary_dir() { return this_binary_dir().string(); }
+
 std::vector<std::string> data_file_candidates(const std::string& relative) {
     std::vector<fs::path> c;
     if (const char* dir = std::getenv("WHITTED_DATA_DIR"); dir && *dir) c.push_back(fs::path(dir) / relative);

@@ -17,4 +17,9 @@ std::string data_file(const std::string& relative);
 /// The candidate paths data_file() tries, in order (normalised; existing or not).
 std::vector<std::string> data_file_candidates(const std::string& relative);
 
+/// The folder of the binary (executable, libwhitted.so or the Python module) that holds
+/// whitted's code, canonical; empty when it cannot be told. Also where the image module is
+/// looked for (image_files.cpp).
+std::string whitted_binary_dir();
+
 }  // namespace whitted

@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "renderer/core/data_files.h"
 #include "renderer/core/error.h"
 #include "renderer/core/image_files_exr.h"
 #include "renderer/core/log.h"
@@ -27,23 +28,13 @@ namespace fs = std::filesystem;
 
 constexpr const char* kModuleName = "libwhitted_oiio.so";
 
-fs::path this_binary_dir() {
-    Dl_info info{};
-    if (dladdr(reinterpret_cast<const void*>(&this_binary_dir), &info) && info.dli_fname) {
-        std::error_code ec;
-        const fs::path p = fs::canonical(info.dli_fname, ec);
-        if (!ec) return p.parent_path();
-    }
-    return {};
-}
-
 /// Where the module may be: $WHITTED_IMAGE_MODULE alone when set (a file: no fallback), else in
 /// order beside the binary holding this code, <prefix>/lib/whitted (an install; also from the
 /// Python module under lib/python3/...), then the path the build wrote it to.
 std::vector<std::string> module_candidates() {
     std::vector<std::string> c;
     if (const char* env = std::getenv("WHITTED_IMAGE_MODULE"); env && *env) return {env};
-    if (const fs::path dir = this_binary_dir(); !dir.empty()) {
+    if (const fs::path dir = whitted_binary_dir(); !dir.empty()) {
         for (const fs::path& p : {dir / kModuleName, dir / "whitted" / kModuleName, dir / "../lib/whitted" / kModuleName,
                                   dir / "../../whitted" / kModuleName, dir / "../../../lib/whitted" / kModuleName})
             c.push_back(p.lexically_normal().string());
