@@ -98,13 +98,18 @@ EnvironmentMap::Level downsample(const EnvironmentMap::Level& src) {
     dst.texels.resize(size_t(dst.width) * size_t(dst.height));
     const auto across = footprints(src.width, dst.width);
     const auto down = footprints(src.height, dst.height);
+    // Solid angle of the covered part of each source row (proportional to it), once per row tap.
+    std::vector<std::vector<double>> row_weight(down.size());
+    for (size_t y = 0; y < down.size(); ++y)
+        for (const Tap& ty : down[y])
+            row_weight[y].push_back(std::cos(kPiD * ty.a / src.height) - std::cos(kPiD * ty.b / src.height));
     for (int y = 0; y < dst.height; ++y)
         for (int x = 0; x < dst.width; ++x) {
             Vec3d sum(0.0);
             double weight = 0;
-            for (const Tap& ty : down[size_t(y)]) {
-                // Solid angle of the covered part of the source row (proportional to it).
-                const double wy = std::cos(kPiD * ty.a / src.height) - std::cos(kPiD * ty.b / src.height);
+            for (size_t k = 0; k < down[size_t(y)].size(); ++k) {
+                const Tap& ty = down[size_t(y)][k];
+                const double wy = row_weight[size_t(y)][k];
                 for (const Tap& tx : across[size_t(x)]) {
                     const double w = wy * (tx.b - tx.a);
                     sum += Vec3d(src.texels[size_t(ty.src) * size_t(src.width) + size_t(tx.src)]) * w;
@@ -550,12 +555,21 @@ EnvironmentLighting EnvironmentMap::split(const SplitSettings& settings) const {
     SummedArea energy(extract ? w : 0, extract ? h : 0);
     std::array<Vec3d, 9> residual_sh{}, extracted_sh{};
     Vec3d residual_power(0.0);
-    std::vector<double> row_energy(static_cast<size_t>(w));
     const TexelGrid grid(w, h);
-    for (int y = 0; y < h; ++y) {
+    // Rows in parallel, each into its own sums; then added up in row order, so the result is the
+    // same for any thread count (and the same as one loop over the rows).
+    struct RowSums {
+        std::array<Vec3d, 9> residual{}, extracted{};
+        Vec3d power{0.0};
+        std::vector<double> energy;
+    };
+    std::vector<RowSums> rows(static_cast<size_t>(h));
+    WorkerPool pool(0);
+    pool.for_each(size_t(h), [&](size_t row, int) {
+        const int y = int(row);
         const double sr = grid.solid_angle(y);
-        std::array<Vec3d, 9> row_residual{}, row_extracted{};
-        Vec3d row_power(0.0);
+        RowSums& r = rows[row];
+        if (extract) r.energy.resize(static_cast<size_t>(w));
         for (int x = 0; x < w; ++x) {
             const size_t i = size_t(y) * size_t(w) + size_t(x);
             const Color c = base.texels[i];
@@ -564,15 +578,19 @@ EnvironmentLighting EnvironmentMap::split(const SplitSettings& settings) const {
             const std::array<float, 9> basis = sh9_basis(world_from_map(Vec3f(grid.direction(x, y))));
             if (extract && lum > threshold) {
                 extracted[i] = c - residual;
-                for (size_t k = 0; k < 9; ++k) row_extracted[k] += Vec3d(extracted[i]) * double(basis[k]);
+                for (size_t k = 0; k < 9; ++k) r.extracted[k] += Vec3d(extracted[i]) * double(basis[k]);
             }
-            if (extract) row_energy[size_t(x)] = luminance(extracted[i]) * sr;
-            for (size_t k = 0; k < 9; ++k) row_residual[k] += Vec3d(residual) * double(basis[k]);
-            row_power += Vec3d(residual);
+            if (extract) r.energy[size_t(x)] = luminance(extracted[i]) * sr;
+            for (size_t k = 0; k < 9; ++k) r.residual[k] += Vec3d(residual) * double(basis[k]);
+            r.power += Vec3d(residual);
         }
-        for (size_t k = 0; k < 9; ++k) residual_sh[k] += row_residual[k] * sr, extracted_sh[k] += row_extracted[k] * sr;
-        residual_power += row_power * sr;
-        if (extract) energy.set_row(y, row_energy);
+    });
+    for (int y = 0; y < h; ++y) {
+        const double sr = grid.solid_angle(y);
+        const RowSums& r = rows[size_t(y)];
+        for (size_t k = 0; k < 9; ++k) residual_sh[k] += r.residual[k] * sr, extracted_sh[k] += r.extracted[k] * sr;
+        residual_power += r.power * sr;
+        if (extract) energy.set_row(y, r.energy);
     }
     out.residual_power = Color(residual_power);
 
