@@ -66,7 +66,7 @@ EnvironmentImage load_environment_image(const std::string& path, size_t max_memo
         in = open_image_file(path);
     } catch (const Error& e) {
         const std::string why = one_line(e.what());
-        throw Error(loc, fmt::format("cannot read the environment map: not an image OpenImageIO reads ({})",
+        throw Error(loc, fmt::format("cannot read the environment map: not an image whitted reads ({})",
                                      why.empty() ? "unknown format" : why));
     }
 

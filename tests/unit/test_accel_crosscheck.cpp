@@ -153,44 +153,51 @@ void run_all(const Scene& scene, const SurfaceFilter& filter, uint32_t ray_count
 }
 
 // embree:flatten=1 (experimental) puts the meshes one instance uses into the top level in world
-// space: the same closest hits as the instanced build (ties allowed) up to float rounding of the
-// transformed vertices, on a scene with a shared, a mirrored (kept instanced) and filtered meshes,
-// and the same transmittance; a bad value is one clear error.
+// space: on random rays, the same closest hits as the instanced build (ties allowed) up to float
+// rounding of the transformed vertices, on a scene with a shared, a mirrored (kept instanced) and
+// filtered meshes, and the same transmittance; a bad value is one clear error. make_rays' rays
+// aimed exactly at vertices and edge midpoints are counted, not bounded: there the two
+// arithmetics may decide an edge differently (as any two Embree builds of other coordinates).
 TEST(AccelCrossCheck, EmbreeFlattenedMatchesInstanced) {
     const Scene s = mixed_scene();
     const PatternFilter filter;
-    const std::vector<Ray> rays = make_rays(s, 2000, 99);
+    constexpr uint32_t kRandom = 2000;  // make_rays' first kRandom rays are random segments
+    const std::vector<Ray> rays = make_rays(s, kRandom, 99);
     // ROBUST, as the renderer builds Embree by default.
     const auto instanced = create_accelerator("embree", s, filter, AccelConfig{true});
     const auto flat = create_accelerator("embree:flatten=1", s, filter, AccelConfig{true});
-    size_t differ = 0, ties = 0, hits = 0;
-    for (const Ray& ray : rays) {
-        const Hit a = flat->intersect(ray, RayKind::Camera), b = instanced->intersect(ray, RayKind::Camera);
-        // Rays that start on a surface (make_rays' "starting on it" set) hit it again at t ~ 0
-        // or not, depending on the rounding of the space they are intersected in: the renderer
-        // never casts those (its origins are offset). Compared beyond t = 1e-5 (extent ~5).
+    size_t differ = 0, ties = 0, hits = 0, edge_differ = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+        const Hit a = flat->intersect(rays[i], RayKind::Camera), b = instanced->intersect(rays[i], RayKind::Camera);
+        // Rays that start on a surface hit it again at t ~ 0 or not, depending on the rounding
+        // of the space they are intersected in: the renderer never casts those (its origins are
+        // offset). Compared beyond t = 1e-5 (the scene's extent is ~5).
         constexpr float kOnSurface = 1e-5f;
         if ((a.valid() && a.t < kOnSurface) || (b.valid() && b.t < kOnSurface)) continue;
         const Agreement g = compare_hits(a, b, 1e-4f);
+        if (i >= kRandom) {
+            edge_differ += g == Agreement::Differ;
+            continue;
+        }
+        if (g == Agreement::Differ)
+            std::printf("  differ: flat t %.7g g%u i%u p%u | inst t %.7g g%u i%u p%u\n", a.t, a.geom, a.inst, a.prim, b.t,
+                        b.geom, b.inst, b.prim);
         differ += g == Agreement::Differ;
-        if (g == Agreement::Differ && differ < 4)
-            std::printf("  differ: flat t %.7g g%u i%u p%u | inst t %.7g g%u i%u p%u | tnear %g\n", a.t, a.geom, a.inst,
-                        a.prim, b.t, b.geom, b.inst, b.prim, ray.tnear);
         ties += g == Agreement::Tie;
         hits += b.valid();
     }
-    std::printf("[ flatten ] %zu rays, %zu hits: %zu differ, %zu ties\n", rays.size(), hits, differ, ties);
-    EXPECT_GT(hits, rays.size() / 4);
-    // What differs are rays that end exactly on their hit (tfar = t: make_rays aims some at
-    // points), where the flattened t rounds past tfar: 4 of 3,750 when written.
-    EXPECT_LE(differ * 500, rays.size());
+    std::printf("[ flatten ] %u random rays, %zu hits: %zu differ, %zu ties; vertex/edge rays: %zu differ of %zu\n",
+                kRandom, hits, differ, ties, edge_differ, rays.size() - kRandom);
+    EXPECT_GT(hits, kRandom / 4);
+    EXPECT_LE(differ * 1000, size_t(kRandom));
     size_t shadow_differ = 0;
-    for (Ray ray : rays) {
+    for (size_t i = 0; i < kRandom; ++i) {
+        Ray ray = rays[i];
         ray.tnear = std::max(ray.tnear, 1e-5f);  // not from on a surface (see above)
         const Color a = flat->transmittance(ray), b = instanced->transmittance(ray);
         shadow_differ += std::fabs(a.x - b.x) > 1e-4f || std::fabs(a.y - b.y) > 1e-4f || std::fabs(a.z - b.z) > 1e-4f;
     }
-    EXPECT_LE(shadow_differ * 1000, rays.size());
+    EXPECT_LE(shadow_differ * 1000, size_t(kRandom));
     EXPECT_THROW(create_accelerator("embree:flatten=2", s, filter), Error);
 }
 
