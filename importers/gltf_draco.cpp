@@ -252,6 +252,10 @@ std::vector<CompressedPrimitive> decode_draco_primitives(tinygltf::Model& model,
                 const size_t id = gltf::extension_uint(*attributes, name.c_str(), 0, path, job.ptr + "/attributes");
                 if (p.attributes.find(name) == p.attributes.end())
                     fail(job.ptr + "/attributes/" + name, fmt::format("the primitive has no {} attribute", name));
+                // The primitive's accessor for it: checked here, before the decoders index with it.
+                const int accessor = p.attributes.at(name);
+                if (accessor < 0 || size_t(accessor) >= model.accessors.size())
+                    fail(fmt::format("/meshes/{}/primitives/{}/attributes/{}", m, i, name), "accessor out of range");
                 job.ids[name] = uint32_t(id);
             }
             const bool triangles = p.mode == TINYGLTF_MODE_TRIANGLES || p.mode == TINYGLTF_MODE_TRIANGLE_STRIP ||

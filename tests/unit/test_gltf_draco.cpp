@@ -216,5 +216,17 @@ TEST(GltfDraco, MismatchesAndCorruptStreamsAreLocatedErrors) {
     EXPECT_EQ(flip.find('\n'), std::string::npos) << flip;
 }
 
+// A fuzzer finding (tests/data/fuzz-regressions/README.md): a Draco primitive whose attribute
+// names an accessor past the array was read before anything checked it (ASan: use after free).
+// Now one located error line.
+TEST(GltfDraco, AttributeAccessorOutOfRangeIsALocatedError) {
+    const std::string file =
+        std::string(WHITTED_TEST_DATA_DIR) + "/fuzz-regressions/glb/asan-draco-attribute-accessor-out-of-range.glb";
+    const std::string err = error_text([&] { load_scene(file); });
+    EXPECT_NE(err.find(file + ": /meshes/0/primitives/0/attributes/POSITION: accessor out of range"), std::string::npos)
+        << err;
+}
+
 }  // namespace
 }  // namespace whitted::test
+
