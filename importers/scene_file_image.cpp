@@ -9,20 +9,13 @@
 #include <fmt/format.h>
 
 #include "importers/image_decode.h"
+#include "importers/one_line.h"
 #include "renderer/core/image_files.h"
 #include "shading/texture_sampling.h"
 
 namespace whitted {
 
 namespace {
-
-std::string one_line(std::string s) {
-    for (char& c : s)
-        if ((unsigned char)c < 0x20 || c == 0x7f) c = ' ';
-    while (!s.empty() && s.back() == ' ') s.pop_back();
-    return s;
-}
-
 void read_pixels(ImageFileReader& in, int channels, PixelType type, void* out, const std::string& file,
                  const FileLoc& loc) {
     try {

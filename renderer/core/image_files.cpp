@@ -113,6 +113,15 @@ std::string ImageDesc::attribute(const std::string& name) const {
     return {};
 }
 
+void ImageDesc::set_attribute(const std::string& name, const std::string& value) {
+    for (auto& [key, old] : attributes)
+        if (key == name) {
+            old = value;
+            return;
+        }
+    attributes.emplace_back(name, value);
+}
+
 size_t ImageDesc::pixel_bytes() const {
     size_t n = 0;
     for (PixelType t : channel_types) n += pixel_type_bytes(t);

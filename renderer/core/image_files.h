@@ -51,6 +51,8 @@ struct ImageDesc {
     int channels() const { return int(channel_names.size()); }
     /// The value of a string attribute, or "" when absent.
     std::string attribute(const std::string& name) const;
+    /// Sets a string attribute: replaced when present, else appended.
+    void set_attribute(const std::string& name, const std::string& value);
     /// Bytes of one pixel with every channel in its own type (the layout write_image_file takes).
     size_t pixel_bytes() const;
 };

@@ -254,15 +254,6 @@ struct EncodedImage {
     std::vector<unsigned char> bytes;
 };
 
-/// The metadata entry `key` set to `value` (replaced when present, else appended).
-void set_attribute(ImageDesc& desc, const std::string& key, const std::string& value) {
-    auto it = std::find_if(desc.attributes.begin(), desc.attributes.end(), [&](const auto& a) { return a.first == key; });
-    if (it != desc.attributes.end())
-        it->second = value;
-    else
-        desc.attributes.emplace_back(key, value);
-}
-
 /// Stores the raw bytes of `value` at `out` (native layout for per-channel EXR formats) and
 /// returns the byte after them.
 template <typename T>
@@ -333,6 +324,7 @@ EncodedImage encode_exr(const Film& film, const OutputSettings& settings) {
             if (film.aovs.prim_id) p = put_bytes(p, film.prim_id[i]);
             if (film.aovs.inst_id) p = put_bytes(p, film.inst_id[i]);
             if (film.aovs.aa_samples) p = put_bytes(p, film.aa_samples[i]);
+            if (i + 1 == range.end()) RT_CHECK(p == image.bytes.data() + (i + 1) * pixel_bytes);  // layout == desc
         }
     });
     return image;
@@ -413,8 +405,6 @@ private:
     bool m_tracked = false;  ///< registered in g_partial_path
 };
 
-/// Writes `image` to "<dir>/.<stem>.tmp-<pid><ext>" and renames it to `path`; on any failure
-/// (including exceptions) the temporary file is removed; errors are whitted::Error("<path>: <reason>").
 /// Test hook: holds the half-written temporary file for a while, so the CLI tests can interrupt
 /// a write in progress (tests/cli/test_cli.cpp). Unset in normal use.
 void test_write_delay() {
@@ -422,6 +412,8 @@ void test_write_delay() {
         std::this_thread::sleep_for(std::chrono::milliseconds(std::clamp(std::atol(delay), 0L, 60000L)));
 }
 
+/// Writes `image` to "<dir>/.<stem>.tmp-<pid><ext>" and renames it to `path`; on any failure
+/// (including exceptions) the temporary file is removed; errors are whitted::Error("<path>: <reason>").
 void write_atomically(const EncodedImage& image, const fs::path& path) {
     const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
     std::error_code ec;
@@ -490,8 +482,8 @@ void write_image(const Film& film, const std::string& path, const OutputSettings
         *kind == FileKind::Exr ? encode_exr(film, settings) : encode_display(film, *kind, settings, path);
     // Metadata as string attributes: EXR header attributes, PNG text chunks, TIFF/JPEG where
     // the format has a place for them (OIIO drops the rest). The caller's keys win.
-    set_attribute(image.desc, "Software", "whitted " WHITTED_VERSION);
-    for (const auto& [key, value] : settings.metadata) set_attribute(image.desc, key, value);
+    image.desc.set_attribute("Software", "whitted " WHITTED_VERSION);
+    for (const auto& [key, value] : settings.metadata) image.desc.set_attribute(key, value);
 
     write_atomically(image, file);
     log_debug("wrote {} ({}x{}, {} channels)", path, image.desc.width, image.desc.height, image.desc.channels());
