@@ -156,8 +156,8 @@ std::vector<uint8_t> encode_png(std::span<const uint8_t> codes, int width, int h
         };
         const uint8_t* prev = y0 == 0 ? zero.data() : raw_row(y0 - 1, rows.data() + row_bytes);
         for (size_t y = y0; y < y1; ++y) {
+            // Alternate halves of `rows`: the row above (16 bits: converted into the other half) stays intact.
             uint8_t* own = rows.data() + ((y - y0) % 2 == 0 ? 0 : row_bytes);
-            if (bits == 16 && prev == own) own = rows.data() + (own == rows.data() ? row_bytes : 0);
             const uint8_t* row = raw_row(y, own);
             uint8_t* out = filtered.data() + y * line;
             size_t best_sum = ~size_t(0);
