@@ -51,11 +51,24 @@ fs::path scratch(const std::string& ext) {
 }
 
 void BM_DisplayCodes(benchmark::State& state) {
-    const DisplayTransform transform{ColorSettings{}};
-    std::vector<uint8_t> out(film().beauty.size() * 3);
-    for (auto _ : state) display_codes(film().beauty, transform, 8, out);
+    // Arguments: bits, and whether a new transform is made per image (its code table built
+    // again, as in a run that writes one file) or one transform serves every image.
+    const int bits = int(state.range(0));
+    const bool fresh = state.range(1) != 0;
+    const DisplayTransform kept{ColorSettings{}};
+    std::vector<uint8_t> out(film().beauty.size() * 3 * size_t(bits / 8));
+    for (auto _ : state) {
+        if (fresh) display_codes(film().beauty, DisplayTransform(ColorSettings{}), bits, out);
+        else display_codes(film().beauty, kept, bits, out);
+    }
 }
-BENCHMARK(BM_DisplayCodes)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DisplayCodes)->ArgsProduct({{8, 16}, {0, 1}})->ArgNames({"bits", "fresh"})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_CodeTableBuild(benchmark::State& state) {
+    // The table alone, per bit depth: made once per transform and bit depth.
+    for (auto _ : state) benchmark::DoNotOptimize(DisplayTransform(ColorSettings{}).code_table(int(state.range(0))));
+}
+BENCHMARK(BM_CodeTableBuild)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_EncodePng(benchmark::State& state) {
     size_t bytes = 0;
@@ -64,8 +77,8 @@ void BM_EncodePng(benchmark::State& state) {
 }
 BENCHMARK(BM_EncodePng)->DenseRange(0, 9)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-void BM_WriteExrZipLevel(benchmark::State& state) {
-    // The beauty as half, as write_image writes it, with compression "zip:<level>".
+void write_exr_half(benchmark::State& state, const std::string& compression) {
+    // The beauty as half, as write_image writes it, with the given compression.
     std::vector<Imath::half> half;
     half.reserve(film().beauty.size() * 3);
     for (const Color& c : film().beauty)
@@ -76,13 +89,18 @@ void BM_WriteExrZipLevel(benchmark::State& state) {
     desc.height = film().height();
     desc.channel_names = {"R", "G", "B"};
     desc.channel_types.assign(3, PixelType::Half);
-    desc.attributes = {{"compression", "zip:" + std::to_string(state.range(0))}};
+    desc.attributes = {{"compression", compression}};
     const fs::path file = scratch(".exr");
     for (auto _ : state) write_image_file(file.string(), desc, half.data());
     state.counters["bytes"] = double(fs::file_size(file));
     fs::remove(file);
 }
+void BM_WriteExrZipLevel(benchmark::State& state) { write_exr_half(state, "zip:" + std::to_string(state.range(0))); }
 BENCHMARK(BM_WriteExrZipLevel)->DenseRange(1, 9)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(write_exr_half, none, std::string("none"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(write_exr_half, rle, std::string("rle"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(write_exr_half, zips_1, std::string("zips:1"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(write_exr_half, piz, std::string("piz"))->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void write_format(benchmark::State& state, const std::string& ext, bool half) {
     OutputSettings settings;

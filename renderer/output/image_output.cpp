@@ -21,6 +21,7 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <mutex>
 #include <optional>
 #include <string_view>
 #include <system_error>
@@ -76,6 +77,8 @@ struct DisplayTransform::Impl {
     std::string view;
     OCIO::ConstConfigRcPtr config;
     OCIO::ConstCPUProcessorRcPtr cpu;  ///< F32 RGB in, F32 RGB out; apply() is const and thread-safe
+    std::once_flag tables_built[2];       ///< 8 and 16 bits
+    std::optional<CodeTable> tables[2];
 };
 
 DisplayTransform::DisplayTransform(const ColorSettings& settings) : m_impl(std::make_unique<Impl>()) {
@@ -139,20 +142,42 @@ DisplayTransform::~DisplayTransform() = default;
 DisplayTransform::DisplayTransform(DisplayTransform&&) noexcept = default;
 
 void DisplayTransform::apply(float* rgb, size_t pixel_count) const {
-    // OCIO converts packed RGB through an RGBA scratch line as long as the image row: process
-    // bounded rows so the scratch stays small for any image size.
-    constexpr size_t kChunk = 4096;
-    for (size_t first = 0; first < pixel_count; first += kChunk) {
-        size_t n = std::min(kChunk, pixel_count - first);
-        OCIO::PackedImageDesc desc(rgb + 3 * first, long(n), 1, 3);
+    // OCIO processes packed RGBA floats in place, while packed RGB goes through a scratch line it
+    // allocates per call: copy bounded runs into RGBA on the stack instead, on all cores for
+    // large inputs (each pixel on its own: the same values for any split).
+    constexpr size_t kRun = 1024;
+    auto run = [&](size_t first, size_t n) {
+        std::array<float, 4 * kRun> rgba;
+        for (size_t i = 0; i < n; ++i) {
+            std::memcpy(&rgba[4 * i], rgb + 3 * (first + i), 3 * sizeof(float));
+            rgba[4 * i + 3] = 1.f;
+        }
+        OCIO::PackedImageDesc desc(rgba.data(), long(n), 1, 4);
         m_impl->cpu->apply(desc);
-    }
+        for (size_t i = 0; i < n; ++i) std::memcpy(rgb + 3 * (first + i), &rgba[4 * i], 3 * sizeof(float));
+    };
+    const size_t runs = (pixel_count + kRun - 1) / kRun;
+    auto range = [&](size_t r0, size_t r1) {
+        for (size_t r = r0; r < r1; ++r) run(r * kRun, std::min(kRun, pixel_count - r * kRun));
+    };
+    if (runs <= 16) return range(0, runs);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, runs, 4), [&](const tbb::blocked_range<size_t>& r) { range(r.begin(), r.end()); });
 }
 
 Color DisplayTransform::apply(Color c) const {
     std::array<float, 3> p{c.x, c.y, c.z};
     m_impl->cpu->applyRGB(p.data());
     return {p[0], p[1], p[2]};
+}
+
+const CodeTable* DisplayTransform::code_table(int bits) const {
+    const int i = bits == 16 ? 1 : 0;
+    std::call_once(m_impl->tables_built[i], [&] {
+        if (bits == 16 || m_impl->cpu->hasChannelCrosstalk()) return;
+        m_impl->tables[i] = CodeTable::build([this](float* rgb, size_t n) { apply(rgb, n); }, bits);
+        log_debug("OCIO: {}-bit code table {}", bits, m_impl->tables[i] ? "in use" : "refused (codes from the transform)");
+    });
+    return m_impl->tables[i] ? &*m_impl->tables[i] : nullptr;
 }
 
 const std::string& DisplayTransform::config_path() const { return m_impl->config_path; }
@@ -168,34 +193,35 @@ void display_codes(std::span<const Color> pixels, const DisplayTransform& transf
         throw Error(fmt::format("display_codes: {} bytes for {} pixels of {} bits", out.size(), pixels.size(), bits));
     // Sanitize before the transform: NaN -> 0 and +-inf -> +-65504 (half max), so that
     // transforms mixing channels (the ACES matrices) never turn one bad channel into NaN.
-    constexpr float kLarge = 65504.f;
     const float scale = bits == 16 ? 65535.f : 255.f;
+    auto put = [&](size_t at, uint32_t code) {
+        if (bits == 16) {
+            const auto q = static_cast<uint16_t>(code);
+            std::memcpy(&out[2 * at], &q, 2);
+        } else {
+            out[at] = static_cast<uint8_t>(code);
+        }
+    };
     // Chunks of pixels on all cores (every pixel on its own: the codes are the same for any split).
     constexpr size_t kChunk = 16384;
     const size_t chunks = (pixels.size() + kChunk - 1) / kChunk;
+    if (const CodeTable* table = transform.code_table(bits)) {
+        // A per-channel transform: each code looked up among the transform's own thresholds.
+        tbb::parallel_for(size_t(0), chunks, [&](size_t chunk) {
+            const size_t first = chunk * kChunk, end = std::min(first + kChunk, pixels.size());
+            for (size_t i = first; i < end; ++i)
+                for (int c = 0; c < 3; ++c) put(3 * i + size_t(c), table->code(c, sanitise_linear(pixels[i][c])));
+        });
+        return;
+    }
     tbb::parallel_for(size_t(0), chunks, [&](size_t chunk) {
         const size_t first = chunk * kChunk, n = std::min(kChunk, pixels.size() - first);
         std::vector<float> rgb(n * 3);
         for (size_t i = 0; i < n; ++i)
-            for (int c = 0; c < 3; ++c) {
-                const float v = pixels[first + i][c];
-                rgb[3 * i + size_t(c)] = std::isnan(v) ? 0.f : std::clamp(v, -kLarge, kLarge);
-            }
+            for (int c = 0; c < 3; ++c) rgb[3 * i + size_t(c)] = sanitise_linear(pixels[first + i][c]);
         transform.apply(rgb.data(), n);
-        for (size_t i = 0; i < rgb.size(); ++i) {
-            // After the transform (OCIO does not clamp): NaN -> 0, then clamp to [0, 1] (+inf -> 1),
-            // then round to nearest. Deterministic: no dithering.
-            float v = rgb[i];
-            v = std::isnan(v) ? 0.f : std::clamp(v, 0.f, 1.f);
-            const auto code = static_cast<uint32_t>(v * scale + 0.5f);
-            const size_t at = 3 * first + i;
-            if (bits == 16) {
-                const auto q = static_cast<uint16_t>(code);
-                std::memcpy(&out[2 * at], &q, 2);
-            } else {
-                out[at] = static_cast<uint8_t>(code);
-            }
-        }
+        // After the transform (OCIO does not clamp): NaN -> 0, clamped to [0, 1], rounded.
+        for (size_t i = 0; i < rgb.size(); ++i) put(3 * first + i, display_code(rgb[i], scale));
     });
 }
 

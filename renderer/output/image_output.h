@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "renderer/film/film.h"
+#include "renderer/output/code_table.h"
 #include "renderer/scene/scene.h"
 
 namespace whitted {
@@ -34,6 +35,10 @@ public:
     /// Transforms packed RGB floats in place (not clamped: OCIO does not clamp).
     void apply(float* rgb, size_t pixel_count) const;
     Color apply(Color c) const;
+    /// The code table of this transform for `bits`, built on first use; nullptr for 16 bits
+    /// (65535 thresholds cost more to find than one image's transform), or when the transform
+    /// mixes channels or fails CodeTable's checks: then codes come from apply().
+    const CodeTable* code_table(int bits) const;
     const std::string& config_path() const;
     const std::string& display() const;
     const std::string& view() const;
