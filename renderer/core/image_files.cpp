@@ -17,6 +17,7 @@
 
 #include "renderer/core/data_files.h"
 #include "renderer/core/error.h"
+#include "renderer/core/image_files_display.h"
 #include "renderer/core/image_files_exr.h"
 #include "renderer/core/log.h"
 
@@ -140,6 +141,8 @@ std::unique_ptr<ImageFileReader> open_image_file(const std::string& path) {
 
 void write_image_file(const std::string& path, const ImageDesc& desc, const void* pixels, void (*before_pixels)()) {
     if (desc.format_name == "openexr") return write_exr_file(path, desc, pixels, before_pixels);
+    if (desc.format_name == "jpeg") return write_jpeg_file(path, desc, pixels, before_pixels);
+    if (desc.format_name == "tiff") return write_tiff_file(path, desc, pixels, before_pixels);
     const ImageModuleApi& a = api();
     std::string error;
     if (!a.write(path.c_str(), &desc, pixels, before_pixels, &error)) throw Error(error);

@@ -34,11 +34,13 @@ endif()
 if(NOT out MATCHES "OCIO config: ${WORK_DIR}/prefix/share/whitted/ocio/config.ocio")
   message(FATAL_ERROR "the installed library did not find its own data in the prefix")
 endif()
-# A JPEG goes through the image module (OpenImageIO), installed beside the library.
+# A JPEG is written in process; reading the PNG back goes through the image module
+# (OpenImageIO), installed beside the library.
 execute_process(COMMAND ${CMAKE_COMMAND} -E env WHITTED_DATA_DIR= WHITTED_IMAGE_MODULE=${WORK_DIR}/prefix/lib/whitted/libwhitted_oiio.so
-                        "${WORK_DIR}/build/consumer" "${SCENE}" "${WORK_DIR}/out.jpg" RESULT_VARIABLE rc OUTPUT_QUIET)
-if(rc OR NOT EXISTS "${WORK_DIR}/out.jpg")
-  message(FATAL_ERROR "the consumer could not write a JPEG through the installed image module: ${rc}")
+                        "${WORK_DIR}/build/consumer" "${SCENE}" "${WORK_DIR}/out.jpg" "${WORK_DIR}/out.png"
+                        RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+if(rc OR NOT EXISTS "${WORK_DIR}/out.jpg" OR NOT out MATCHES "read ${WORK_DIR}/out.png: 48x")
+  message(FATAL_ERROR "the consumer could not write a JPEG or read a PNG through the installed image module: ${rc} ${out}")
 endif()
 # The Python module from the prefix (when it was built): imports, renders, finds its data there.
 if(PYTHON)

@@ -2,7 +2,9 @@
 // reader (OpenImageIO's libpng, which checks every CRC and the Adler-32), to exactly the codes
 // given, at 8 and 16 bits, for sizes that leave partial bands and one-row bands; the bytes do not
 // depend on the thread count; metadata comes back as text; write_image's PNG holds exactly
-// display_codes' values. And the image module: OIIO is loaded for JPEG, not for PNG or EXR.
+// display_codes' values, and so do TIFF files (written through libtiff, strips deflated in
+// parallel); JPEG files are the ones OpenImageIO writes at its default quality. And the image
+// module: no file written loads OIIO; reading a non-EXR image does.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -157,12 +159,76 @@ TEST(PngEncoder, WriteImageStoresExactlyTheDisplayCodes) {
     }
 }
 
+TEST(TiffWriter, StoresExactlyTheDisplayCodesForAnySize) {
+    // Heights that leave a partial strip (strips of 32 rows), one-pixel-wide images, 8 and 16 bits.
+    for (auto [w, h] : {std::pair{97, 61}, std::pair{1, 33}, std::pair{40, 32}, std::pair{3, 1}}) {
+        Film film(w, h, PixelWindow{0, 0, w, h}, AovSet{});
+        std::mt19937 rng(uint32_t(w * 1000 + h));
+        std::uniform_real_distribution<float> u(-0.1f, 1.6f);
+        for (Color& c : film.beauty) c = Color(u(rng), u(rng), u(rng));
+        for (int bits : {8, 16}) {
+            OutputSettings settings;
+            settings.bits = bits;
+            settings.metadata["whitted:test"] = "yes";
+            const fs::path file = temp_file(fmt::format("film{}x{}_{}.tif", w, h, bits));
+            write_image(film, file.string(), settings);
+            std::vector<uint8_t> expected(size_t(w) * size_t(h) * 3 * (bits == 16 ? 2 : 1));
+            display_codes(film.beauty, DisplayTransform(settings.color), bits, expected);
+            const Decoded d = decode(file, bits);
+            EXPECT_EQ(d.spec.format, bits == 16 ? OIIO::TypeUInt16 : OIIO::TypeUInt8);
+            EXPECT_TRUE(d.codes == expected) << w << "x" << h << " at " << bits << " bits";
+            EXPECT_EQ(d.spec.get_string_attribute("Software"), "whitted " WHITTED_VERSION);
+            EXPECT_NE(d.spec.get_string_attribute("ImageDescription").find("whitted:test: yes"), std::string::npos);
+            fs::remove(file);
+        }
+    }
+}
+
+TEST(TiffWriter, BytesDoNotDependOnTheThreadCount) {
+    Film film(300, 200, PixelWindow{0, 0, 300, 200}, AovSet{});
+    for (size_t i = 0; i < film.beauty.size(); ++i) film.beauty[i] = Color(float(i % 300) / 300.f, float(i / 300) / 200.f, 0.5f);
+    std::vector<std::string> files;
+    for (int threads : {1, 2, 5}) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+        const fs::path file = temp_file(fmt::format("threads{}.tif", threads));
+        write_image(film, file.string(), OutputSettings{});
+        std::ifstream in(file, std::ios::binary);
+        files.emplace_back(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        fs::remove(file);
+    }
+    EXPECT_EQ(files[0], files[1]);
+    EXPECT_EQ(files[0], files[2]);
+}
+
+TEST(JpegWriter, DecodesLikeOpenImageIOsOwnJpegOfTheSameCodes) {
+    // whitted's JPEG against OIIO's JPEG (its default quality) of the very same 8-bit codes.
+    const int w = 120, h = 77;
+    Film film(w, h, PixelWindow{0, 0, w, h}, AovSet{});
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) film.beauty[size_t(y * w + x)] = Color(float(x) / w, float(y) / h, float((x * y) % 17) / 17.f);
+    const fs::path ours = temp_file("ours.jpg"), theirs = temp_file("theirs.jpg");
+    write_image(film, ours.string(), OutputSettings{});
+    std::vector<uint8_t> codes(size_t(w) * size_t(h) * 3);
+    display_codes(film.beauty, DisplayTransform(ColorSettings{}), 8, codes);
+    auto out = OIIO::ImageOutput::create(theirs.string());
+    ASSERT_TRUE(out);
+    ASSERT_TRUE(out->open(theirs.string(), OIIO::ImageSpec(w, h, 3, OIIO::TypeUInt8)));
+    ASSERT_TRUE(out->write_image(OIIO::TypeUInt8, codes.data()));
+    out->close();
+    const Decoded a = decode(ours, 8), b = decode(theirs, 8);
+    EXPECT_TRUE(a.codes == b.codes);
+    EXPECT_NE(a.codes, codes) << "a JPEG is lossy: equal codes would mean the test compares nothing";
+    fs::remove(ours);
+    fs::remove(theirs);
+}
+
 // This test program links OIIO itself (for the checks above), so whether whitted's module is
 // loaded is asked of whitted, not of the process's library list (tests/cli covers the latter).
-TEST(ImageModule, PngAndExrDoNotLoadItJpegDoes) {
+TEST(ImageModule, NoWriteLoadsItReadingAPngDoes) {
     Film film(4, 4, PixelWindow{0, 0, 4, 4}, AovSet{});
     film.beauty[5] = Color(0.25f, 0.5f, 2.f);
-    const fs::path png = temp_file("lazy.png"), exr = temp_file("lazy.exr"), jpg = temp_file("lazy.jpg");
+    const fs::path png = temp_file("lazy.png"), exr = temp_file("lazy.exr"), jpg = temp_file("lazy.jpg"),
+                   tif = temp_file("lazy.tif");
     write_image(film, png.string(), OutputSettings{});
     OutputSettings full;
     full.exr_half = false;
@@ -170,16 +236,16 @@ TEST(ImageModule, PngAndExrDoNotLoadItJpegDoes) {
     write_image(film, exr.string(), full);
     std::map<std::string, std::string> metadata;
     const Film back = read_film(exr.string(), &metadata);
-    EXPECT_FALSE(image_module_loaded()) << "PNG or EXR went through the OIIO module";
+    write_image(film, jpg.string(), OutputSettings{});
+    write_image(film, tif.string(), OutputSettings{});
+    EXPECT_FALSE(image_module_loaded()) << "writing PNG, EXR, JPEG or TIFF, or reading EXR, went through the OIIO module";
     EXPECT_EQ(back.width(), 4);
     EXPECT_EQ(back.beauty[5].z, 2.f);
     EXPECT_EQ(metadata["Software"], "whitted " WHITTED_VERSION);
     EXPECT_EQ(metadata["whitted:test"], "exr");
-    write_image(film, jpg.string(), OutputSettings{});
+    EXPECT_EQ(open_image_file(png.string())->desc().width, 4);
     EXPECT_TRUE(image_module_loaded());
     int w = 0, h = 0;
     EXPECT_EQ(read_image_rgb(jpg.string(), w, h).size(), 4u * 4u * 3u);
-    fs::remove(png);
-    fs::remove(exr);
-    fs::remove(jpg);
+    for (const fs::path& f : {png, exr, jpg, tif}) fs::remove(f);
 }

@@ -1,0 +1,22 @@
+// JPEG and TIFF files written in process (libjpeg-turbo, libtiff): display-referred 8/16-bit RGB,
+// without loading the OIIO module (image_files.cpp sends "jpeg" and "tiff" here).
+#pragma once
+
+#include <string>
+
+#include "renderer/core/image_files.h"
+
+namespace whitted {
+
+/// As write_image_file with format_name "jpeg": 8-bit RGB, quality from the "CompressionQuality"
+/// attribute (default 98, as OpenImageIO) with 4:2:0 chroma; "Software" and the other attributes go into one
+/// comment marker ("key: value" lines).
+void write_jpeg_file(const std::string& path, const ImageDesc& desc, const void* pixels, void (*before_pixels)());
+
+/// As write_image_file with format_name "tiff": 8- or 16-bit RGB in strips of 32 rows, each
+/// deflated (zlib level from "compression" = "zip:N", default 1) with the horizontal predictor,
+/// strips compressed on all cores; "Software" and "ImageDescription" attributes become tags,
+/// the others join ImageDescription. The file's bytes do not depend on the thread count.
+void write_tiff_file(const std::string& path, const ImageDesc& desc, const void* pixels, void (*before_pixels)());
+
+}  // namespace whitted
