@@ -1,4 +1,4 @@
-// JPEG through libjpeg(-turbo), TIFF through libtiff with strips deflated in parallel.
+// JPEG through libjpeg(-turbo), TIFF through libtiff with strips deflated (libdeflate) in parallel.
 #include "renderer/core/image_files_display.h"
 
 #include <algorithm>
@@ -14,7 +14,7 @@
 #include <jpeglib.h>
 #include <tbb/parallel_for.h>
 #include <tiffio.h>
-#include <zlib.h>
+#include <libdeflate.h>
 
 #include "renderer/core/error.h"
 
@@ -110,7 +110,7 @@ void write_tiff_file(const std::string& path, const ImageDesc& desc, const void*
     const int bits = checked_bits(desc, true);
     int level = 1;
     if (const std::string c = desc.attribute("compression"); c.rfind("zip:", 0) == 0)
-        level = std::clamp(std::atoi(c.c_str() + 4), 1, 9);
+        level = std::clamp(std::atoi(c.c_str() + 4), 1, 12);
     constexpr int kRowsPerStrip = 32;
     const size_t bytes_per_sample = size_t(bits / 8);
     const size_t row_bytes = size_t(desc.width) * 3 * bytes_per_sample;
@@ -119,7 +119,7 @@ void write_tiff_file(const std::string& path, const ImageDesc& desc, const void*
     // Each strip: the horizontal predictor (each sample minus the one of the pixel to its left,
     // modulo 2^bits, in native order as libtiff writes it) and its own zlib stream, on all cores.
     std::vector<std::vector<uint8_t>> compressed(static_cast<size_t>(strips));
-    std::vector<int> failures(static_cast<size_t>(strips), Z_OK);
+    std::vector<char> failures(static_cast<size_t>(strips), 0);
     tbb::parallel_for(0, strips, [&](int s) {
         const int y0 = s * kRowsPerStrip, y1 = std::min(desc.height, y0 + kRowsPerStrip);
         std::vector<uint8_t> raw(size_t(y1 - y0) * row_bytes);
@@ -139,13 +139,20 @@ void write_tiff_file(const std::string& path, const ImageDesc& desc, const void*
                 }
             }
         }
-        uLongf size = compressBound(uLong(raw.size()));
-        compressed[size_t(s)].resize(size);
-        failures[size_t(s)] = compress2(compressed[size_t(s)].data(), &size, raw.data(), uLong(raw.size()), level);
-        compressed[size_t(s)].resize(size);
+        libdeflate_compressor* c = libdeflate_alloc_compressor(level);
+        if (!c) {
+            failures[size_t(s)] = 1;
+            return;
+        }
+        std::vector<uint8_t>& out = compressed[size_t(s)];
+        out.resize(libdeflate_zlib_compress_bound(c, raw.size()));
+        const size_t size = libdeflate_zlib_compress(c, raw.data(), raw.size(), out.data(), out.size());
+        libdeflate_free_compressor(c);
+        failures[size_t(s)] = size == 0;
+        out.resize(size);
     });
-    for (int rc : failures)
-        if (rc != Z_OK) throw Error(fmt::format("zlib: compress2 failed ({})", rc));
+    for (char failed : failures)
+        if (failed) throw Error(fmt::format("libdeflate: cannot compress a TIFF strip at level {}", level));
 
     // libtiff's warnings and errors would go to stderr: the first error becomes our message.
     static thread_local std::string tiff_error;

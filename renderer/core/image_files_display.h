@@ -14,7 +14,8 @@ namespace whitted {
 void write_jpeg_file(const std::string& path, const ImageDesc& desc, const void* pixels, void (*before_pixels)());
 
 /// As write_image_file with format_name "tiff": 8- or 16-bit RGB in strips of 32 rows, each
-/// deflated (zlib level from "compression" = "zip:N", default 1) with the horizontal predictor,
+/// a zlib stream (libdeflate level from "compression" = "zip:N", 1-12, default 1) of the rows with
+/// the horizontal predictor,
 /// strips compressed on all cores; "Software" and "ImageDescription" attributes become tags,
 /// the others join ImageDescription. The file's bytes do not depend on the thread count.
 void write_tiff_file(const std::string& path, const ImageDesc& desc, const void* pixels, void (*before_pixels)());
