@@ -69,6 +69,29 @@ TEST(StartupCli, RendersToEveryFormatDoNotLoadOpenImageIOReadingAPngDoes) {
     fs::remove_all(dir);
 }
 
+// Runs that load or render restart once with glibc's malloc asking for transparent huge pages
+// (renderer/core/huge_pages.h) when the kernel offers them; WHITTED_HUGE_PAGES=0 and a caller's own
+// GLIBC_TUNABLES setting are respected.
+TEST(StartupCli, RunsAskForHugePagesWhenTheKernelOffersThem) {
+    const std::string thp = slurp("/sys/kernel/mm/transparent_hugepage/enabled");
+    const bool offered = contains(thp, "[always]") || contains(thp, "[madvise]");
+    const std::string scene = "info '" + std::string(WHITTED_ASSETS_DIR) + "/scenes/whitted1980.json' --log-level debug";
+    Result r = run(scene);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(contains(r.err, offered ? "transparent huge pages requested" : "transparent huge pages not requested"))
+        << "kernel: " << thp << "\n" << r.err;
+    ::setenv("WHITTED_HUGE_PAGES", "0", 1);
+    r = run(scene);
+    ::unsetenv("WHITTED_HUGE_PAGES");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(contains(r.err, "transparent huge pages not requested")) << r.err;
+    ::setenv("GLIBC_TUNABLES", "glibc.malloc.hugetlb=0", 1);
+    r = run(scene);
+    ::unsetenv("GLIBC_TUNABLES");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(contains(r.err, "transparent huge pages not requested")) << r.err;
+}
+
 // $WHITTED_IMAGE_MODULE names the module to use, with no fallback: a missing one is one clear
 // error line naming it and a non-zero exit, never a crash, and no file is left behind.
 TEST(StartupCli, MissingImageModuleIsOneClearError) {

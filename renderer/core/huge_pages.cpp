@@ -1,0 +1,61 @@
+// restart_with_huge_pages: glibc reads GLIBC_TUNABLES once, at start-up, so the only way to set a
+// tunable from inside is to start again with it.
+#include "renderer/core/huge_pages.h"
+
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <string>
+
+#include <unistd.h>
+
+namespace whitted {
+
+namespace {
+
+constexpr const char* kTunable = "glibc.malloc.hugetlb=1";
+
+/// The kernel's THP mode is "always" or "madvise" (not "never", and the file exists).
+bool kernel_offers_huge_pages() {
+    std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
+    std::string line;
+    if (!std::getline(in, line)) return false;
+    return line.find("[always]") != std::string::npos || line.find("[madvise]") != std::string::npos;
+}
+
+/// GLIBC_TUNABLES already sets glibc.malloc.hugetlb (to any value: the caller's choice stands).
+bool tunable_given() {
+    const char* t = std::getenv("GLIBC_TUNABLES");
+    return t != nullptr && std::strstr(t, "glibc.malloc.hugetlb=") != nullptr;
+}
+
+/// Runs that only print (--help, --version, no arguments) gain nothing from a second start.
+bool only_prints(char** argv) {
+    if (argv[0] == nullptr || argv[1] == nullptr) return true;
+    for (char** a = argv + 1; *a != nullptr; ++a)
+        if (std::strcmp(*a, "--help") == 0 || std::strcmp(*a, "-h") == 0 || std::strcmp(*a, "--version") == 0) return true;
+    return false;
+}
+
+}  // namespace
+
+bool huge_pages_requested() {
+    const char* t = std::getenv("GLIBC_TUNABLES");
+    const char* at = t != nullptr ? std::strstr(t, "glibc.malloc.hugetlb=") : nullptr;
+    return at != nullptr && at[std::strlen("glibc.malloc.hugetlb=")] != '0';
+}
+
+void restart_with_huge_pages(char** argv) {
+    if (tunable_given() || only_prints(argv)) return;
+    if (const char* opt = std::getenv("WHITTED_HUGE_PAGES"); opt != nullptr && std::strcmp(opt, "0") == 0) return;
+    if (!kernel_offers_huge_pages()) return;
+    const char* old = std::getenv("GLIBC_TUNABLES");
+    const std::string tunables = (old != nullptr && old[0] != '\0') ? std::string(old) + ":" + kTunable : kTunable;
+    if (::setenv("GLIBC_TUNABLES", tunables.c_str(), 1) != 0) return;
+    ::execv("/proc/self/exe", argv);
+    // exec failed: go on as we are, with the environment as it was.
+    if (old != nullptr) ::setenv("GLIBC_TUNABLES", old, 1);
+    else ::unsetenv("GLIBC_TUNABLES");
+}
+
+}  // namespace whitted
