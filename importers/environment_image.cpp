@@ -95,23 +95,25 @@ EnvironmentImage load_environment_image(const std::string& path, size_t max_memo
     const bool srgb = !spec.floating_point && color_space != "Linear" && color_space != "linear";
 
     const size_t texels = size_t(spec.width) * size_t(spec.height);
-    std::vector<float> px(texels * size_t(channels));
-    try {
-        in->read(0, channels, PixelType::Float, px.data());
-    } catch (const Error& e) {
-        throw Error(loc, fmt::format("cannot read the environment map: {}", one_line(e.what())));
-    }
-
     EnvironmentImage image;
     image.name = std::filesystem::path(path).stem().string();
     image.path = path;
     image.width = spec.width;
     image.height = spec.height;
     image.texels.resize(texels);
+    // RGB is read straight into the texels (a Color is three floats); grey into a buffer first.
+    static_assert(sizeof(Color) == 3 * sizeof(float));
+    std::vector<float> grey(channels == 1 ? texels : 0);
+    try {
+        in->read(0, channels, PixelType::Float, channels == 3 ? static_cast<void*>(image.texels.data()) : grey.data());
+    } catch (const Error& e) {
+        throw Error(loc, fmt::format("cannot read the environment map: {}", one_line(e.what())));
+    }
+
     size_t clamped = 0;
     for (size_t i = 0; i < texels; ++i) {
-        const float* v = &px[i * size_t(channels)];
-        float rgb[3] = {v[0], channels == 3 ? v[1] : v[0], channels == 3 ? v[2] : v[0]};
+        const Color v = channels == 3 ? image.texels[i] : Color(grey[i]);
+        float rgb[3] = {v.x, v.y, v.z};
         bool bad = false;
         for (float& c : rgb) {
             if (!std::isfinite(c) || c < 0.f) {

@@ -466,6 +466,12 @@ EnvironmentMap::EnvironmentMap(const Environment& env, int threads, Use use, uin
     }
     m_mean = Color(sum / (4.0 * kPiD));
 
+    // split() reads level 0 alone: no pyramid, residual or prefilter for it.
+    if (use == Use::SplitOnly) {
+        m_levels.push_back(std::move(base));
+        return;
+    }
+
     // MIP pyramid down to 1 x 1.
     m_levels = pyramid(std::move(base));
 
@@ -480,8 +486,7 @@ EnvironmentMap::EnvironmentMap(const Environment& env, int threads, Use use, uin
         m_residual = pyramid(std::move(residual));
     }
 
-    // The GGX prefilter of the map and of the residual (not needed to split the light).
-    if (use == Use::SplitOnly) return;
+    // The GGX prefilter of the map and of the residual.
     if ((levels & kAllPrefilterLevels) == 0) return;
     WorkerPool pool(threads);
     m_prefiltered = prefilter(m_levels, levels, pool);
@@ -551,7 +556,12 @@ EnvironmentLighting EnvironmentMap::split(const SplitSettings& settings) const {
     // Per texel: the excess over the threshold (hue kept) to the extracted map, the rest to the
     // residual. Both are projected on SH9 (solid-angle weighted, texel-centre directions, world
     // space); the extracted one only to correct the lights' error below.
-    std::vector<Color> extracted(extract ? base.texels.size() : 0);
+    // A texel's extracted part, recomputed where needed rather than stored for the whole map.
+    auto extracted_at = [&](size_t i) {
+        const Color c = base.texels[i];
+        const double lum = luminance(c);
+        return lum > threshold ? c - residual_texel(c, lum, threshold) : Color(0.f);
+    };
     SummedArea energy(extract ? w : 0, extract ? h : 0);
     std::array<Vec3d, 9> residual_sh{}, extracted_sh{};
     Vec3d residual_power(0.0);
@@ -576,11 +586,10 @@ EnvironmentLighting EnvironmentMap::split(const SplitSettings& settings) const {
             const double lum = luminance(c);
             const Color residual = residual_texel(c, lum, threshold);
             const std::array<float, 9> basis = sh9_basis(world_from_map(Vec3f(grid.direction(x, y))));
-            if (extract && lum > threshold) {
-                extracted[i] = c - residual;
-                for (size_t k = 0; k < 9; ++k) r.extracted[k] += Vec3d(extracted[i]) * double(basis[k]);
-            }
-            if (extract) r.energy[size_t(x)] = luminance(extracted[i]) * sr;
+            const Color extracted = extract && lum > threshold ? c - residual : Color(0.f);
+            if (extract && lum > threshold)
+                for (size_t k = 0; k < 9; ++k) r.extracted[k] += Vec3d(extracted) * double(basis[k]);
+            if (extract) r.energy[size_t(x)] = luminance(extracted) * sr;
             for (size_t k = 0; k < 9; ++k) r.residual[k] += Vec3d(residual) * double(basis[k]);
             r.power += Vec3d(residual);
         }
@@ -605,7 +614,7 @@ EnvironmentLighting EnvironmentMap::split(const SplitSettings& settings) const {
             const double sr = grid.solid_angle(y);
             Vec3d row_power(0.0), row_centroid(0.0);
             for (int x = r.x0; x < r.x1; ++x) {
-                const Color e = extracted[size_t(y) * size_t(w) + size_t(x)];
+                const Color e = extracted_at(size_t(y) * size_t(w) + size_t(x));
                 row_power += Vec3d(e);
                 row_centroid += grid.direction(x, y) * luminance(e);
             }

@@ -113,8 +113,8 @@ public:
     /// (0 = all hardware threads; the result is the same for any count).
     /// Throws whitted::Error when env.image is null or empty.
     explicit EnvironmentMap(const Environment& env, int threads = 0);
-    /// What a map is built for: rendering (every lookup), or only split() (no prefiltered levels:
-    /// prefiltered() and residual_prefiltered() must not be called).
+    /// What a map is built for: rendering (every lookup), or only split() (level 0 alone: no MIP
+    /// pyramid, residual or prefiltered levels, so no lookup may be made).
     enum class Use { Rendering, SplitOnly };
     /// `levels`: bit k set = prefilter level k (kPrefilterRoughness[k]) is built; the others stay
     /// empty (prefilter_levels_read tells which levels a range of roughness reads; the scene
