@@ -145,7 +145,11 @@ std::unique_ptr<Accelerator> create_backend(const std::string& name, const Scene
             else if (*isa == "sse2") c.allow_avx2 = false;
             else throw Error(fmt::format("accelerator '{}': isa must be auto or sse2", name));
         }
-        spec.check_all_used("precision, bv, width, isa, bins, leaf, traversal_cost, intersection_cost, block");
+        if (const std::string* f = spec.find("flatten")) {
+            if (*f == "0" || *f == "1") c.flatten = *f == "1";
+            else throw Error(fmt::format("accelerator '{}': flatten must be 0 or 1", name));
+        }
+        spec.check_all_used("precision, bv, width, isa, flatten, bins, leaf, traversal_cost, intersection_cost, block");
         return create_bvh_accelerator(scene, filter, c);
     }
     if (spec.name() == "kdop") {

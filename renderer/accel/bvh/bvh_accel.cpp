@@ -136,7 +136,7 @@ private:
 
 template <typename T, typename V>
 std::unique_ptr<Accelerator> make_bvh(const char* name, const Scene& scene, const SurfaceFilter& filter,
-                                      const BvhBuildConfig& build) {
+                                      const BvhBuildConfig& build, bool flatten = true) {
     using Blas = PrimBvh<T, V, TrianglePrims<T>>;
     using SphereBlas = PrimBvh<T, V, SpherePrims<T>>;
     // Spheres: small leaves (a sphere test costs about as much as a node test).
@@ -144,14 +144,14 @@ std::unique_ptr<Accelerator> make_bvh(const char* name, const Scene& scene, cons
     sphere_build.max_leaf_size = std::min(build.max_leaf_size, 2);
     return std::make_unique<TwoLevelAccelerator<T, Blas, SphereBlas>>(
         name, scene, filter, [&](const Mesh& m) { return Blas(TrianglePrims<T>(m), build); },
-        [&](SpherePrims<T>&& s) { return SphereBlas(std::move(s), sphere_build); }, true);
+        [&](SpherePrims<T>&& s) { return SphereBlas(std::move(s), sphere_build); }, true, flatten);
 }
 
 /// `bvh` with N-wide mesh BVHs and an N-wide top level over instances (float boxes); the
 /// spheres keep the binary tree.
 template <int N>
 std::unique_ptr<Accelerator> make_wide_bvh(const Scene& scene, const SurfaceFilter& filter, const BvhBuildConfig& build,
-                                           const WideBvhOptions& options) {
+                                           const WideBvhOptions& options, bool flatten) {
     using Blas = WideTriangleBvh<N>;
     using SphereBlas = PrimBvh<float, AabbVolume<float>, SpherePrims<float>>;
     using Top = WideInstanceTree<N>;
@@ -160,7 +160,7 @@ std::unique_ptr<Accelerator> make_wide_bvh(const Scene& scene, const SurfaceFilt
     return std::make_unique<TwoLevelAccelerator<float, Blas, SphereBlas, Top>>(
         "bvh", scene, filter, [&](const Mesh& m) { return Blas(TrianglePrims<float>(m), build, options); },
         [&](SpherePrims<float>&& s) { return SphereBlas(std::move(s), sphere_build); },
-        [&](const std::vector<Bounds3f>& boxes) { return Top(boxes, options); });
+        [&](const std::vector<Bounds3f>& boxes) { return Top(boxes, options); }, flatten);
 }
 
 template <typename T>
@@ -181,14 +181,14 @@ std::unique_ptr<Accelerator> create_bvh_accelerator(const Scene& scene, const Su
         const WideBvhOptions options{config.allow_avx2};
         // Without AVX2 an 8-wide node test is two SSE halves: 4-wide trees are faster there.
         const int width = config.width != 0 ? config.width : (config.allow_avx2 && simd::cpu_has_avx2() ? 8 : 4);
-        return width == 4 ? make_wide_bvh<4>(scene, filter, config.build, options)
-                          : make_wide_bvh<8>(scene, filter, config.build, options);
+        return width == 4 ? make_wide_bvh<4>(scene, filter, config.build, options, config.flatten)
+                          : make_wide_bvh<8>(scene, filter, config.build, options, config.flatten);
     }
     if (config.volume == BoundingVolume::Sphere)
-        return dbl ? make_bvh<double, SphereVolume<double>>("bvh", scene, filter, config.build)
-                   : make_bvh<float, SphereVolume<float>>("bvh", scene, filter, config.build);
-    return dbl ? make_bvh<double, AabbVolume<double>>("bvh", scene, filter, config.build)
-               : make_bvh<float, AabbVolume<float>>("bvh", scene, filter, config.build);
+        return dbl ? make_bvh<double, SphereVolume<double>>("bvh", scene, filter, config.build, config.flatten)
+                   : make_bvh<float, SphereVolume<float>>("bvh", scene, filter, config.build, config.flatten);
+    return dbl ? make_bvh<double, AabbVolume<double>>("bvh", scene, filter, config.build, config.flatten)
+               : make_bvh<float, AabbVolume<float>>("bvh", scene, filter, config.build, config.flatten);
 }
 
 std::unique_ptr<Accelerator> create_kdop_accelerator(const Scene& scene, const SurfaceFilter& filter,

@@ -30,6 +30,9 @@ struct BvhConfig {
                                                  ///< only), 2 (the binary tree; always for double/sphere),
                                                  ///< 0 = 8 where the CPU has AVX2, else 4
     bool allow_avx2 = true;                      ///< `isa=sse2` false: 8-wide node tests in SSE halves
+    bool flatten = true;                         ///< meshes used by one instance share one world-space
+                                                 ///< BLAS (common/two_level.h; float only); `flatten=0`:
+                                                 ///< every mesh in its own
 };
 
 /// The binned SAH settings `bvh` uses for wide trees (width 4 or 8) unless options override them.

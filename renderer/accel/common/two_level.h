@@ -6,7 +6,12 @@
 // plain loop), or `bvh`'s 8/4-wide tree (WideInstanceTree, bvh/wide_bvh.h). The scene's analytic
 // spheres are one more structure of the backend's own kind (SphereBlas, built over SpherePrims in
 // world space), traced beside the top level with the world-space ray; infinite planes are added
-// outside (planes.h).
+// outside (planes.h). With `flatten` (the default for float structures), the meshes that exactly
+// one instance uses (with a transform that keeps orientation) are put in world space into one
+// shared BLAS instead, whose hits report the instance, mesh and primitive they came from; meshes
+// used more than once stay instanced. Every float backend flattens alike, so they still agree with
+// the brute-force oracle hit for hit; double-precision structures never flatten (world-space
+// vertices would be rounded to float).
 //
 // A BLAS type provides
 //   template <class Query> bool traverse(const Vec3<T>& org, const Vec3<T>& dir, T tnear, Query& q) const;
@@ -27,6 +32,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 #include <functional>
 #include <memory>
@@ -138,27 +144,53 @@ public:
     /// With the binary top level: `bvh_top` false = loop over all instances (the brute-force
     /// oracle).
     TwoLevelAccelerator(std::string name, const Scene& scene, const SurfaceFilter& filter, const BlasBuilder& build_blas,
-                        const SphereBuilder& build_spheres, bool bvh_top)
+                        const SphereBuilder& build_spheres, bool bvh_top, bool flatten = true)
         : TwoLevelAccelerator(std::move(name), scene, filter, build_blas, build_spheres,
-                              [bvh_top](const std::vector<Bounds3<T>>& boxes) { return Top(boxes, bvh_top); }) {}
+                              [bvh_top](const std::vector<Bounds3<T>>& boxes) { return Top(boxes, bvh_top); }, flatten) {}
 
     /// Builds the BLASes in parallel over meshes (each build is deterministic), then the top
     /// level over the instances' world boxes and the sphere structure (when the scene has
-    /// spheres).
+    /// spheres). `flatten`: single-use meshes share one world-space BLAS (see the top).
     TwoLevelAccelerator(std::string name, const Scene& scene, const SurfaceFilter& filter, const BlasBuilder& build_blas,
-                        const SphereBuilder& build_spheres, const TopBuilder& build_top)
+                        const SphereBuilder& build_spheres, const TopBuilder& build_top, bool flatten = true)
         : m_name(std::move(name)), m_scene(scene), m_filter(filter) {
         const auto start = std::chrono::steady_clock::now();
         // Spheres: world space, each with its own geometry id and filter flags.
         SpherePrims<T> spheres(scene, filter);
         if (spheres.size() > 0) m_spheres = std::make_unique<SphereBlas>(build_spheres(std::move(spheres)));
-        // Bottom level: one structure per mesh that has triangles.
+        // Which instances are flattened (none unless at least two would share the flat BLAS).
+        const std::vector<uint8_t> flat = flattened_instances(scene, flatten && std::is_same_v<T, float>);
+        std::vector<uint8_t> mesh_flat(scene.meshes.size(), 0);
+        for (size_t i = 0; i < flat.size(); ++i)
+            if (flat[i]) mesh_flat[scene.instances[i].mesh] = 1;
+        // Bottom level: one structure per instanced mesh that has triangles, and the flat one.
         m_blas.resize(scene.meshes.size());
         tbb::parallel_for(size_t(0), scene.meshes.size(), [&](size_t m) {
-            if (scene.meshes[m].triangle_count() > 0) m_blas[m] = std::make_unique<Blas>(build_blas(scene.meshes[m]));
+            if (scene.meshes[m].triangle_count() > 0 && !mesh_flat[m])
+                m_blas[m] = std::make_unique<Blas>(build_blas(scene.meshes[m]));
         });
-        // Instances with their inverse transforms and world boxes.
+        if (std::find(flat.begin(), flat.end(), 1) != flat.end()) {
+            // World-space vertices (transformed in double, rounded once), each triangle's origin kept.
+            Mesh merged;
+            for (size_t i = 0; i < flat.size(); ++i) {
+                if (!flat[i]) continue;
+                const Instance& inst = scene.instances[i];
+                const Mesh& mesh = scene.meshes[inst.mesh];
+                const auto base = uint32_t(merged.positions.size());
+                for (const Vec3f& p : mesh.positions) merged.positions.push_back(Vec3f(inst.world_from_object.apply_point(Vec3d(p))));
+                for (uint32_t idx : mesh.indices) merged.indices.push_back(base + idx);
+                const InstanceContext ctx{inst.mesh, uint32_t(i), filter.mesh_flags(inst.mesh)};
+                for (uint32_t p = 0; p < mesh.triangle_count(); ++p) m_flat_prims.push_back({ctx, p});
+            }
+            m_flat_blas = std::make_unique<Blas>(build_blas(merged));
+        }
+        // Instances with their inverse transforms and world boxes; the flat BLAS is one more
+        // entry with the identity transform.
         std::vector<Bounds3<T>> boxes;
+        if (m_flat_blas) {
+            m_instances.push_back(InstanceData{Affine<T>(), kFlatMesh, kInvalidId, 0});
+            boxes.push_back(m_flat_blas->bounds());
+        }
         for (size_t i = 0; i < scene.instances.size(); ++i) {
             const Instance& inst = scene.instances[i];
             if (!m_blas[inst.mesh]) continue;
@@ -173,15 +205,17 @@ public:
         // Size figures: the BLASes, the top level and the per-instance data.
         double sah_weighted = 0.0;
         size_t tris = 0;
-        for (size_t m = 0; m < m_blas.size(); ++m) {
-            if (!m_blas[m]) continue;
-            const BlasStats s = m_blas[m]->stats();
+        auto add = [&](const Blas& blas, size_t triangles) {
+            const BlasStats s = blas.stats();
             m_stats.bytes += s.bytes;
             m_stats.nodes += s.nodes;
             m_stats.references += s.references;
-            sah_weighted += s.sah_cost * double(scene.meshes[m].triangle_count());
-            tris += scene.meshes[m].triangle_count();
-        }
+            sah_weighted += s.sah_cost * double(triangles);
+            tris += triangles;
+        };
+        for (size_t m = 0; m < m_blas.size(); ++m)
+            if (m_blas[m]) add(*m_blas[m], scene.meshes[m].triangle_count());
+        if (m_flat_blas) add(*m_flat_blas, m_flat_prims.size());
         m_stats.sah_cost = tris ? sah_weighted / double(tris) : 0.0;
         if (m_spheres) {
             const BlasStats s = m_spheres->stats();
@@ -189,7 +223,7 @@ public:
             m_stats.nodes += s.nodes;
             m_stats.references += s.references;
         }
-        m_stats.bytes += m_top.bytes() + m_instances.size() * sizeof(InstanceData);
+        m_stats.bytes += m_top.bytes() + m_instances.size() * sizeof(InstanceData) + m_flat_prims.size() * sizeof(FlatPrim);
         m_stats.nodes += m_top.nodes();
     }
 
@@ -212,10 +246,51 @@ public:
 private:
     struct InstanceData {
         Affine<T> object_from_world;
-        uint32_t mesh;
+        uint32_t mesh;   ///< kFlatMesh: the flat BLAS
         uint32_t inst;
         uint32_t flags;
     };
+    static constexpr uint32_t kFlatMesh = kInvalidId;
+
+    /// A triangle of the flat BLAS: where it came from.
+    struct FlatPrim {
+        InstanceContext ctx;  ///< its mesh, instance and filter needs
+        uint32_t prim;        ///< its index in its mesh
+    };
+
+    /// The query seen by the flat BLAS: each report first takes the triangle's own context and
+    /// index, so the hit or crossing names the instance, mesh and primitive it came from.
+    template <class Query>
+    struct FlatQuery {
+        static constexpr bool kAllHits = Query::kAllHits;
+        Query& q;
+        const FlatPrim* prims;
+        decltype(Query::tmax)& tmax;
+        bool report(T t, T u, T v, uint32_t prim, uint8_t part = 0) {
+            const FlatPrim& f = prims[prim];
+            q.ctx = f.ctx;
+            return q.report(t, u, v, f.prim, part);
+        }
+    };
+
+    /// Per instance: whether it goes into the flat BLAS (its mesh used by it alone, with
+    /// triangles, and a transform that keeps orientation); all 0 unless at least two qualify.
+    static std::vector<uint8_t> flattened_instances(const Scene& scene, bool flatten) {
+        std::vector<uint8_t> flat(scene.instances.size(), 0);
+        if (!flatten) return flat;
+        std::vector<uint32_t> uses(scene.meshes.size(), 0);
+        for (const Instance& inst : scene.instances)
+            if (inst.mesh < uses.size()) ++uses[inst.mesh];
+        size_t count = 0;
+        for (size_t i = 0; i < scene.instances.size(); ++i) {
+            const Instance& inst = scene.instances[i];
+            if (inst.mesh < uses.size() && uses[inst.mesh] == 1 && scene.meshes[inst.mesh].triangle_count() > 0 &&
+                inst.world_from_object.det3() > 0.0)
+                flat[i] = 1, ++count;
+        }
+        if (count < 2) flat.assign(flat.size(), 0);
+        return flat;
+    }
 
     /// crossing_cosine() of a triangle crossing in world space (its vertices through the
     /// instance transform, in double); 1 for spheres, whose two roots are told apart by `part`.
@@ -251,6 +326,13 @@ private:
         // per-ray constants gets the world ray's when the instance's transform is the identity.
         auto visit = [&](uint32_t k, const auto& prepared) WHITTED_ALWAYS_INLINE_LAMBDA -> bool {
             const InstanceData& d = m_instances[k];
+            if (d.mesh == kFlatMesh) {  // world space: the world ray's constants serve as they are
+                FlatQuery<Query> fq{q, m_flat_prims.data(), q.tmax};
+                if constexpr (requires { m_flat_blas->traverse_prepared(prepared, fq); })
+                    return m_flat_blas->traverse_prepared(prepared, fq);
+                else
+                    return m_flat_blas->traverse(org, dir, tnear, fq);
+            }
             q.ctx = InstanceContext{d.mesh, d.inst, d.flags};
             const Blas& blas = *m_blas[d.mesh];
             using Prepared = std::decay_t<decltype(prepared)>;
@@ -269,7 +351,9 @@ private:
     std::string m_name;
     const Scene& m_scene;  ///< outlives the accelerator (accelerator.h): triangles of crossings
     const SurfaceFilter& m_filter;
-    std::vector<std::unique_ptr<Blas>> m_blas;
+    std::vector<std::unique_ptr<Blas>> m_blas;  ///< per mesh; null for flattened meshes
+    std::unique_ptr<Blas> m_flat_blas;         ///< the flattened meshes in world space, or null
+    std::vector<FlatPrim> m_flat_prims;        ///< per triangle of m_flat_blas
     std::unique_ptr<SphereBlas> m_spheres;   ///< null when the scene has no (valid) spheres
     std::vector<InstanceData> m_instances;
     Top m_top;                               ///< over m_instances
