@@ -8,9 +8,10 @@
 
 namespace whitted {
 
-/// Allocates kTailBytes more than asked for, zero-filled, after the capacity() elements, so a reader with
-/// wide loads (Embree fetches a FLOAT3 vertex with one 16-byte load) may read past the last
-/// element without leaving the allocation. Stateless: all instances are equal.
+/// Allocates kTailBytes more than asked for after the capacity() elements, so a reader with wide
+/// loads (Embree fetches a FLOAT3 vertex with one 16-byte load) may read past the last element
+/// without leaving the allocation. The whole block starts zeroed, so the bytes such a reader sees
+/// past size() are initialized too (memory checkers). Stateless: all instances are equal.
 template <typename T, size_t kTailBytes>
 struct TailPaddedAllocator {
     using value_type = T;
@@ -18,18 +19,17 @@ struct TailPaddedAllocator {
     struct rebind {
         using other = TailPaddedAllocator<U, kTailBytes>;
     };
-    static constexpr size_t tail_bytes = kTailBytes;
 
     TailPaddedAllocator() noexcept = default;
     template <typename U>
     TailPaddedAllocator(const TailPaddedAllocator<U, kTailBytes>&) noexcept {}
 
-    /// n elements and the zeroed tail; aligned like operator new (16 bytes).
+    /// Room for n elements and the tail, all zero bytes; aligned like operator new (16 bytes).
     T* allocate(size_t n) {
         if (n > (size_t(-1) - kTailBytes) / sizeof(T)) throw std::bad_array_new_length();
-        auto* p = static_cast<char*>(::operator new(n * sizeof(T) + kTailBytes));
-        std::memset(p + n * sizeof(T), 0, kTailBytes);
-        return reinterpret_cast<T*>(p);
+        void* p = ::operator new(n * sizeof(T) + kTailBytes);
+        std::memset(p, 0, n * sizeof(T) + kTailBytes);
+        return static_cast<T*>(p);
     }
     void deallocate(T* p, size_t n) noexcept { ::operator delete(p, n * sizeof(T) + kTailBytes); }
 
