@@ -133,9 +133,15 @@ bool reaches_plane(const Light& light, const Plane& plane, LightReach& reach) {
     return true;
 }
 
-template <typename T>
-size_t bytes_of(const std::vector<T>& v) {
+template <typename T, typename Alloc>
+size_t bytes_of(const std::vector<T, Alloc>& v) {
     return v.size() * sizeof(T);
+}
+
+/// A PaddedVector with its zeroed tail (Mesh::positions).
+template <typename T>
+size_t bytes_of(const PaddedVector<T>& v) {
+    return v.empty() ? 0 : v.size() * sizeof(T) + kPaddedVectorTailBytes;
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 
 #include "renderer/core/vecmath.h"
 #include "renderer/scene/environment.h"
+#include "renderer/scene/padded_vector.h"
 
 namespace whitted {
 
@@ -24,7 +25,8 @@ namespace whitted {
 /// Triangle mesh in object space, one material. Optional attributes are empty when absent.
 struct Mesh {
     std::string name;                 ///< "<gltf mesh name>/<primitive index>" or a user name
-    std::vector<Vec3f> positions;     ///< object-space vertex positions
+    PaddedVector<Vec3f> positions;    ///< object-space vertex positions; 16 zero bytes follow the last
+                                      ///< one in the allocation (the Embree backend shares the array)
     std::vector<Vec3f> normals;       ///< per-vertex shading normals (unit), same count as positions
     std::vector<Vec4f> tangents;      ///< xyz unit tangent, w = bitangent sign (+1/-1); may be empty
     std::vector<Vec2f> uv0;           ///< TEXCOORD_0; may be empty

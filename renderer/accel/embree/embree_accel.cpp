@@ -51,8 +51,11 @@ bool memory_monitor(void* device_bytes, ssize_t bytes, bool post) {
 /// Bytes after the last vertex: Embree reads vertices with 16-byte SSE loads, so the 12-byte
 /// FLOAT3 of the last one would otherwise be read 4 bytes past the end (Embree's
 /// rtcSetSharedGeometryBuffer documentation); a read outside the buffer inside Embree is
-/// invisible to AddressSanitizer, so the padding is explicit rather than left to Embree.
+/// invisible to AddressSanitizer, so the padding is explicit rather than left to Embree. The
+/// Scene's positions carry it (Mesh::positions is a PaddedVector) and are shared; the world-space
+/// copies of flattened meshes get it here.
 constexpr size_t kVertexPadding = 16;
+static_assert(kPaddedVectorTailBytes >= kVertexPadding);
 
 /// Surfaces remembered per shadow ray to count each crossing once. Beyond this many distinct
 /// crossings de-duplication stops (the product is still taken; documented limit).
@@ -290,33 +293,40 @@ public:
             if (mesh.triangle_count() == 0) continue;
             const Mat4d* to_world = flat_instance[m] >= 0 ? &scene.instances[size_t(flat_instance[m])].world_from_object : nullptr;
             RTCGeometry g = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_TRIANGLE);
-            // Vertex buffer with explicit tail padding (kVertexPadding), zero-filled.
-            const size_t vertex_bytes = mesh.positions.size() * 3 * sizeof(float);
-            RTCBuffer vb = rtcNewBuffer(m_device, vertex_bytes + kVertexPadding);
-            auto* v = vb ? static_cast<float*>(rtcGetBufferData(vb)) : nullptr;
-            if (v) {
-                std::memset(reinterpret_cast<char*>(v) + vertex_bytes, 0, kVertexPadding);
-                rtcSetGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, vb, 0, 3 * sizeof(float),
-                                     mesh.positions.size());
+            // Vertices: the Scene's own array, shared (its allocation is padded, scene.h), or for a
+            // flattened mesh a world-space copy with the same padding, zero-filled.
+            float* v = nullptr;
+            if (to_world) {
+                const size_t vertex_bytes = mesh.positions.size() * 3 * sizeof(float);
+                RTCBuffer vb = rtcNewBuffer(m_device, vertex_bytes + kVertexPadding);
+                v = vb ? static_cast<float*>(rtcGetBufferData(vb)) : nullptr;
+                if (v) {
+                    std::memset(reinterpret_cast<char*>(v) + vertex_bytes, 0, kVertexPadding);
+                    rtcSetGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, vb, 0, 3 * sizeof(float),
+                                         mesh.positions.size());
+                }
+                if (vb) rtcReleaseBuffer(vb);  // the geometry holds its own reference
+                if (!v) {
+                    rtcReleaseGeometry(g);
+                    throw_pending("allocating geometry buffers");
+                    throw Error("Embree: cannot allocate geometry buffers");
+                }
+                for (size_t i = 0; i < mesh.positions.size(); ++i) {
+                    const Vec3f p(to_world->apply_point(Vec3d(mesh.positions[i])));  // double, rounded once
+                    v[3 * i + 0] = p.x;
+                    v[3 * i + 1] = p.y;
+                    v[3 * i + 2] = p.z;
+                }
+            } else {
+                static_assert(sizeof(Vec3f) == 3 * sizeof(float));
+                rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0,
+                                           sizeof(Vec3f), mesh.positions.size());
             }
-            if (vb) rtcReleaseBuffer(vb);  // the geometry holds its own reference
-            // The index buffer is the Scene's own array, shared: Embree reads indices one by one (the
-            // 16-byte-load padding rule is for vertex buffers), and the Scene outlives the
-            // accelerator (accelerator.h). That saves 12 bytes per triangle.
+            // The index buffer is the Scene's own array, shared too: Embree reads indices one by one
+            // (the 16-byte-load padding rule is for vertex buffers). The Scene outlives the
+            // accelerator (accelerator.h).
             rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.indices.data(), 0,
                                        3 * sizeof(uint32_t), mesh.triangle_count());
-            if (!v) {
-                rtcReleaseGeometry(g);
-                throw_pending("allocating geometry buffers");
-                throw Error("Embree: cannot allocate geometry buffers");
-            }
-            for (size_t i = 0; i < mesh.positions.size(); ++i) {
-                Vec3f p = mesh.positions[i];
-                if (to_world) p = Vec3f(to_world->apply_point(Vec3d(p)));  // double, rounded once
-                v[3 * i + 0] = p.x;
-                v[3 * i + 1] = p.y;
-                v[3 * i + 2] = p.z;
-            }
             const uint32_t needs = filter.mesh_flags(uint32_t(m));
             if (needs & SurfaceFilter::kNeedsAccept) rtcSetGeometryIntersectFilterFunction(g, &intersect_filter);
             // Shadow rays read kNeedsTransmittance only (accelerator.h): an opaque single-sided
@@ -428,9 +438,9 @@ public:
     }
 
     std::string name() const override { return "embree"; }
-    /// bytes: what the device's memory monitor counts once the build is done (BVHs, the padded
-    /// vertex copies, Embree's internal buffers), plus the sphere table; the shared index
-    /// arrays belong to the Scene and are not counted.
+    /// bytes: what the device's memory monitor counts once the build is done (BVHs, the
+    /// world-space vertex copies of flattened meshes, Embree's internal buffers), plus the sphere
+    /// table; the shared vertex and index arrays belong to the Scene and are not counted.
     AccelStats stats() const override {
         return {m_build_seconds, size_t(std::max<int64_t>(m_device_bytes.load(), 0)) + m_sphere_bytes};
     }
