@@ -29,6 +29,7 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
+#include "importers/file_bytes.h"
 #include "importers/gltf_accessor.h"
 #include "importers/gltf_extensions.h"
 #include "importers/gltf_json.h"
@@ -58,7 +59,7 @@ constexpr size_t kMaxJsonDepth = 64;  ///< array/object nesting (docs/fuzzing.md
 // ---------------------------------------------------------------------------------------------
 // Reading the file
 
-std::vector<uint8_t> read_file(const std::string& path, size_t max_memory) {
+FileBytes read_file(const std::string& path, size_t max_memory) {
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) throw Error(file_loc(path), "is a directory, not a glTF file");
     std::ifstream in(path, std::ios::binary);
@@ -72,7 +73,7 @@ std::vector<uint8_t> read_file(const std::string& path, size_t max_memory) {
     if (uint64_t(size) > max_memory)
         throw Error(file_loc(path),
                     fmt::format("file of {} bytes exceeds the memory limit of {} bytes", size, max_memory));
-    std::vector<uint8_t> bytes(static_cast<size_t>(size));
+    FileBytes bytes(static_cast<size_t>(size));
     if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size)) throw Error(file_loc(path), "read error");
     return bytes;
 }
@@ -268,25 +269,63 @@ bool refuse_write(std::string* err, const std::string&, const std::vector<unsign
     return false;
 }
 
-/// Deepest nesting of JSON arrays/objects, scanning at most until `limit` is passed: tinygltf
-/// converts extras and extensions recursively, so a file of 100000 '[' would overflow the stack.
-size_t json_depth(const char* p, size_t n, size_t limit) {
-    size_t depth = 0, deepest = 0;
+/// What one pass over the JSON text finds before tinygltf parses it.
+struct JsonOutline {
+    size_t depth = 0;  ///< deepest array/object nesting (the scan stops once it passes the limit)
+    // Objects in the top-level arrays tinygltf fills one element at a time.
+    size_t accessors = 0, buffer_views = 0, meshes = 0, nodes = 0, materials = 0;
+};
+
+/// Scans the JSON text for its nesting depth, stopping once `limit` is passed (tinygltf converts
+/// extras and extensions recursively, so a file of 100000 '[' would overflow the stack), and
+/// counts the objects of the large top-level arrays so the model's vectors can be reserved.
+JsonOutline json_outline(const char* p, size_t n, size_t limit) {
+    JsonOutline o;
+    size_t depth = 0;
     bool in_string = false;
-    for (size_t i = 0; i < n && deepest <= limit; ++i) {
+    size_t string_start = 0;
+    std::string_view last_key;  // the last string closed at depth 1: a key of the root object
+    size_t* counter = nullptr;  // the count of the top-level array being scanned
+    auto counter_for = [&o](std::string_view key) -> size_t* {
+        if (key == "accessors") return &o.accessors;
+        if (key == "bufferViews") return &o.buffer_views;
+        if (key == "meshes") return &o.meshes;
+        if (key == "nodes") return &o.nodes;
+        if (key == "materials") return &o.materials;
+        return nullptr;
+    };
+    for (size_t i = 0; i < n && o.depth <= limit; ++i) {
         const char c = p[i];
         if (in_string) {
-            if (c == '\\') ++i;  // skip the escaped character
-            else if (c == '"') in_string = false;
+            if (c == '\\') {
+                ++i;  // skip the escaped character
+            } else if (c == '"') {
+                in_string = false;
+                if (depth == 1) last_key = std::string_view(p + string_start, i - string_start);
+            }
         } else if (c == '"') {
             in_string = true;
+            string_start = i + 1;
         } else if (c == '[' || c == '{') {
-            deepest = std::max(deepest, ++depth);
+            if (depth == 2 && c == '{' && counter != nullptr) ++*counter;
+            if (depth == 1 && c == '[') counter = counter_for(last_key);
+            o.depth = std::max(o.depth, ++depth);
         } else if ((c == ']' || c == '}') && depth > 0) {
-            --depth;
+            if (--depth == 1) counter = nullptr;
         }
     }
-    return deepest;
+    return o;
+}
+
+/// Room for `n` elements, when they fit the memory limit: tinygltf appends them one at a time
+/// (and only clears, never shrinks, the vectors first). A hint: without it the vector grows.
+template <typename T>
+void reserve_for(std::vector<T>& v, size_t n, size_t max_memory) {
+    if (n == 0 || n > max_memory / sizeof(T)) return;
+    try {
+        v.reserve(n);
+    } catch (const std::bad_alloc&) {
+    }
 }
 
 /// Shortens the payload of every data URI in a message ("data:...;base64,AAAA... (123456 chars)"):
@@ -411,8 +450,9 @@ private:
         // JSON nesting: the whole file, or the GLB JSON chunk (its length was checked above).
         const size_t json_offset = binary ? 20 : 0;
         const size_t json_size = binary ? size_t(load_u32(bytes.data() + 12)) : bytes.size();
-        if (json_depth(reinterpret_cast<const char*>(bytes.data()) + json_offset, json_size, kMaxJsonDepth) >
-            kMaxJsonDepth)
+        const JsonOutline outline =
+            json_outline(reinterpret_cast<const char*>(bytes.data()) + json_offset, json_size, kMaxJsonDepth);
+        if (outline.depth > kMaxJsonDepth)
             fail("", "invalid JSON: arrays/objects nested deeper than {} levels", kMaxJsonDepth);
 
         // A required extension whitted cannot honour is reported as that, before tinygltf gets to
@@ -434,6 +474,12 @@ private:
         m_uri_policy.base = m_base_dir;
         m_uri_policy.allow_outside = m_options.allow_outside_uris;
         m_uri_policy.max_bytes = m_options.max_memory;
+        // Reserved, the vectors are written once instead of moved through every doubling.
+        reserve_for(m_model.accessors, outline.accessors, m_options.max_memory);
+        reserve_for(m_model.bufferViews, outline.buffer_views, m_options.max_memory);
+        reserve_for(m_model.meshes, outline.meshes, m_options.max_memory);
+        reserve_for(m_model.nodes, outline.nodes, m_options.max_memory);
+        reserve_for(m_model.materials, outline.materials, m_options.max_memory);
         tinygltf::TinyGLTF parser;
         parser.SetImageLoader(&capture_image, &m_loader);
         parser.SetFsCallbacks(
@@ -1230,8 +1276,8 @@ private:
 }  // namespace
 
 Scene import_gltf(const std::string& path, const ImportOptions& options) {
-    const std::vector<uint8_t> bytes = read_file(path, options.max_memory);
-    return GltfImporter(path, options).run(bytes);
+    const FileBytes bytes = read_file(path, options.max_memory);
+    return GltfImporter(path, options).run(bytes.bytes());
 }
 
 Scene import_gltf_memory(std::span<const uint8_t> bytes, const std::string& path, const ImportOptions& options) {
