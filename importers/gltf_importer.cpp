@@ -27,6 +27,7 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <tbb/parallel_for.h>
 #include <tiny_gltf.h>
 
 #include "importers/file_bytes.h"
@@ -1030,7 +1031,7 @@ private:
 
     // ---- geometry -----------------------------------------------------------------------------
     /// Geometry of one primitive in object space (material and name set by the caller).
-    Mesh build_geometry(const tinygltf::Primitive& p, const std::string& ptr) {
+    Mesh build_geometry(const tinygltf::Primitive& p, const std::string& ptr, WarningLog& warnings) const {
         Mesh mesh;
         // Positions (finite: checked by validation).
         const AccessorData pos = accessor_data(m_model, p.attributes.at("POSITION"));
@@ -1079,7 +1080,7 @@ private:
             });
             need_generated = std::find(bad.begin(), bad.end(), 1) != bad.end();
             if (need_generated)
-                m_warnings.add("bad-normals",
+                warnings.add("bad-normals",
                                fmt::format("{}: zero or non-finite normals replaced by generated ones", ptr));
         }
         if (need_generated) {
@@ -1127,12 +1128,12 @@ private:
                 for (size_t i = 0; i < nv; ++i)
                     if (mesh.tangents[i].xyz() == Vec3f(0.f))
                         mesh.tangents[i] = Vec4f(any_perpendicular(mesh.normals[i]), 1.f);
-                m_warnings.add("bad-tangents", fmt::format("{}: zero or non-finite tangents replaced", ptr));
+                warnings.add("bad-tangents", fmt::format("{}: zero or non-finite tangents replaced", ptr));
             }
         } else if (tangent_uv >= 0) {
             const std::vector<Vec2f>& uv = tangent_uv == 0 ? mesh.uv0 : mesh.uv1;
             if (uv.empty())
-                m_warnings.add("normal-map-no-uv", fmt::format("{}: the normal texture uses TEXCOORD_{}, which the "
+                warnings.add("normal-map-no-uv", fmt::format("{}: the normal texture uses TEXCOORD_{}, which the "
                                                                "primitive lacks: no tangents, normal map has no effect",
                                                                ptr, tangent_uv));
             else
@@ -1178,35 +1179,74 @@ private:
 
     /// Geometry shared by every primitive with the same attribute and index accessors and mode
     /// (MetalRoughSpheres: 98 materials on one sphere) is decoded once.
-    using GeometryKey = std::tuple<std::map<std::string, int>, int, int, int>;
+    struct GeometryKey {
+        const std::map<std::string, int>* attributes;  ///< the primitive's, in m_model
+        int indices, mode, tangent_uv;
+        bool operator==(const GeometryKey& o) const {
+            return indices == o.indices && mode == o.mode && tangent_uv == o.tangent_uv && *attributes == *o.attributes;
+        }
+    };
+    struct GeometryKeyHash {
+        size_t operator()(const GeometryKey& k) const {
+            // Equal maps list equal accessors in the same (name) order: the names need no hashing.
+            uint64_t h = (uint64_t(uint32_t(k.indices)) << 32) ^ (uint64_t(uint32_t(k.mode)) << 8) ^ uint32_t(k.tangent_uv);
+            for (const auto& entry : *k.attributes) h = (h ^ uint32_t(entry.second)) * 0x100000001b3ull;
+            return size_t(h ^ (h >> 29));
+        }
+    };
 
     void build_meshes() {
-        std::map<GeometryKey, uint32_t> decoded;  // geometry -> first Scene mesh holding it
-        m_scene.meshes.reserve(m_requests.size());
-        for (const MeshKey& k : m_requests) {
-            const tinygltf::Mesh& gm = m_model.meshes[size_t(k.mesh)];
-            const tinygltf::Primitive& p = gm.primitives[size_t(k.primitive)];
-            const std::string ptr = fmt::format("/meshes/{}/primitives/{}", k.mesh, k.primitive);
+        // Which request decodes its geometry and which copies an earlier request's.
+        const size_t n = m_requests.size();
+        std::unordered_map<GeometryKey, uint32_t, GeometryKeyHash> decoded;  // geometry -> first request
+        decoded.reserve(n);
+        std::vector<uint32_t> source(n);  // request -> the request whose geometry it uses
+        std::vector<uint32_t> unique;     // requests that decode, in order
+        for (size_t i = 0; i < n; ++i) {
+            const tinygltf::Primitive& p = primitive(m_requests[i]);
             const int tangent_uv =
                 needs_tangents(p) ? int(m_scene.materials[size_t(p.material)].normal_texture.uv_set) : -1;
-            const GeometryKey gkey{p.attributes, p.indices, p.mode, tangent_uv};
+            const auto [it, inserted] = decoded.emplace(GeometryKey{&p.attributes, p.indices, p.mode, tangent_uv},
+                                                        uint32_t(i));
+            source[i] = it->second;
+            if (inserted) unique.push_back(uint32_t(i));
+        }
+
+        // Decode on all cores; each geometry's warnings are kept apart and appended below in
+        // request order, so the log is the same for any thread count.
+        std::vector<Mesh> built(unique.size());
+        std::vector<WarningLog> logs(unique.size());
+        tbb::parallel_for(size_t(0), unique.size(), [&](size_t u) {
+            const MeshKey& k = m_requests[unique[u]];
+            const std::string ptr = fmt::format("/meshes/{}/primitives/{}", k.mesh, k.primitive);
+            built[u] = build_geometry(primitive(k), ptr, logs[u]);
+            report_mesh_numbers(sanitize_mesh_numbers(built[u]), ptr, logs[u]);
+            if (k.mirrored) mirror(built[u]);
+        });
+
+        m_scene.meshes.reserve(n);
+        for (size_t i = 0, u = 0; i < n; ++i) {
+            const MeshKey& k = m_requests[i];
+            const tinygltf::Mesh& gm = m_model.meshes[size_t(k.mesh)];
             Mesh mesh;
-            if (auto it = decoded.find(gkey); it != decoded.end()) {
-                const Mesh& src = m_scene.meshes[it->second];
-                mesh = src;
-                if (m_requests[it->second].mirrored != k.mirrored) mirror(mesh);
+            if (source[i] == i) {
+                m_warnings.append(logs[u]);
+                mesh = std::move(built[u++]);
             } else {
-                mesh = build_geometry(p, ptr);
-                report_mesh_numbers(sanitize_mesh_numbers(mesh), ptr, m_warnings);
-                if (k.mirrored) mirror(mesh);
-                decoded.emplace(gkey, uint32_t(m_scene.meshes.size()));
+                mesh = m_scene.meshes[source[i]];
+                if (m_requests[source[i]].mirrored != k.mirrored) mirror(mesh);
             }
             mesh.name = fmt::format("{}/{}", gm.name.empty() ? fmt::format("mesh {}", k.mesh) : gm.name, k.primitive);
             if (k.mirrored) mesh.name += " (mirrored)";
-            mesh.material = p.material >= 0 ? uint32_t(p.material) : default_material();
+            const int material = gm.primitives[size_t(k.primitive)].material;
+            mesh.material = material >= 0 ? uint32_t(material) : default_material();
             m_scene.meshes.push_back(std::move(mesh));
         }
         if (m_scene.materials.empty()) default_material();
+    }
+
+    const tinygltf::Primitive& primitive(const MeshKey& k) const {
+        return m_model.meshes[size_t(k.mesh)].primitives[size_t(k.primitive)];
     }
 
     /// The copy of a mesh for transforms with a negative determinant: glTF says such a transform
