@@ -1,6 +1,6 @@
 // A whole file's bytes in memory, in pages the kernel may back with transparent huge pages
-// (private to importers/). Read into ordinary 4 KiB pages, a 40 MB file costs 10,000 page faults,
-// about 0.2 s on the virtual machines whitted is measured on (docs/measurements/performance.md).
+// (private to importers/): read into ordinary 4 KiB pages, a large file costs a page fault per
+// 4 KiB, which is most of its reading time on a virtual machine (docs/measurements/performance.md).
 #pragma once
 
 #include <cstddef>

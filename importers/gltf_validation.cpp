@@ -73,31 +73,31 @@ public:
 
     Pointer operator+(std::string_view piece) const {
         Pointer p = *this;
-        p.append({piece, 0, false});
+        if (!piece.empty()) p.append({piece.data(), piece.size()});
         return p;
     }
     Pointer operator+(size_t index) const {
         Pointer p = *this;
-        p.append({{}, index, true});
+        p.append({nullptr, index});
         return p;
     }
 
     std::string text() const {
         std::string out = m_head;
         for (size_t i = 0; i < m_count; ++i) {
-            if (m_pieces[i].is_index)
-                out += std::to_string(m_pieces[i].index);
+            const Piece& piece = m_pieces[i];
+            if (piece.text == nullptr)
+                out += std::to_string(piece.value);
             else
-                out += m_pieces[i].text;
+                out.append(piece.text, piece.value);
         }
         return out;
     }
 
 private:
     struct Piece {
-        std::string_view text;
-        size_t index = 0;
-        bool is_index = false;
+        const char* text;  ///< nullptr: an index
+        size_t value;      ///< the text's length, or the index
     };
     void append(const Piece& piece) {
         if (m_count == m_pieces.size()) {  // full: join what there is into the head
@@ -683,7 +683,8 @@ private:
         auto check_array = [&](const std::vector<double>& v, size_t want, const char* key) {
             if (v.empty()) return;
             if (v.size() != want) fail(ptr + "/" + key, "{} needs {} numbers, has {}", key, want, v.size());
-            for (size_t k = 0; k < v.size(); ++k) check_finite(v[k], ptr + "/" + key + "/" + k);
+            for (size_t k = 0; k < v.size(); ++k)
+                if (!std::isfinite(v[k])) check_finite(v[k], ptr + "/" + key + "/" + k);
         };
         check_array(node.matrix, 16, "matrix");
         check_array(node.translation, 3, "translation");
