@@ -1,5 +1,6 @@
 #include "importers/gltf_compressed.h"
 
+#include <algorithm>
 #include <set>
 #include <string_view>
 
@@ -45,6 +46,9 @@ std::optional<std::vector<uint8_t>> prepare_compressed(std::span<const uint8_t> 
 
 std::vector<CompressedPrimitive> meshopt_primitives(const tinygltf::Model& model) {
     std::vector<CompressedPrimitive> records;
+    const std::string name = "EXT_meshopt_compression";
+    const auto compressed = [&](const tinygltf::BufferView& v) { return v.extensions.count(name) != 0; };
+    if (std::none_of(model.bufferViews.begin(), model.bufferViews.end(), compressed)) return records;
     for (size_t m = 0; m < model.meshes.size(); ++m)
         for (size_t i = 0; i < model.meshes[m].primitives.size(); ++i) {
             const tinygltf::Primitive& p = model.meshes[m].primitives[i];

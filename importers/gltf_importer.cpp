@@ -27,8 +27,10 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <tbb/parallel_for.h>
 #include <tiny_gltf.h>
 
+#include "importers/file_bytes.h"
 #include "importers/gltf_accessor.h"
 #include "importers/gltf_extensions.h"
 #include "importers/gltf_json.h"
@@ -58,7 +60,7 @@ constexpr size_t kMaxJsonDepth = 64;  ///< array/object nesting (docs/fuzzing.md
 // ---------------------------------------------------------------------------------------------
 // Reading the file
 
-std::vector<uint8_t> read_file(const std::string& path, size_t max_memory) {
+FileBytes read_file(const std::string& path, size_t max_memory) {
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) throw Error(file_loc(path), "is a directory, not a glTF file");
     std::ifstream in(path, std::ios::binary);
@@ -72,7 +74,7 @@ std::vector<uint8_t> read_file(const std::string& path, size_t max_memory) {
     if (uint64_t(size) > max_memory)
         throw Error(file_loc(path),
                     fmt::format("file of {} bytes exceeds the memory limit of {} bytes", size, max_memory));
-    std::vector<uint8_t> bytes(static_cast<size_t>(size));
+    FileBytes bytes(static_cast<size_t>(size));
     if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size)) throw Error(file_loc(path), "read error");
     return bytes;
 }
@@ -268,25 +270,63 @@ bool refuse_write(std::string* err, const std::string&, const std::vector<unsign
     return false;
 }
 
-/// Deepest nesting of JSON arrays/objects, scanning at most until `limit` is passed: tinygltf
-/// converts extras and extensions recursively, so a file of 100000 '[' would overflow the stack.
-size_t json_depth(const char* p, size_t n, size_t limit) {
-    size_t depth = 0, deepest = 0;
+/// What one pass over the JSON text finds before tinygltf parses it.
+struct JsonOutline {
+    size_t depth = 0;  ///< deepest array/object nesting (the scan stops once it passes the limit)
+    // Objects in the top-level arrays tinygltf fills one element at a time.
+    size_t accessors = 0, buffer_views = 0, meshes = 0, nodes = 0, materials = 0;
+};
+
+/// Scans the JSON text for its nesting depth, stopping once `limit` is passed (tinygltf converts
+/// extras and extensions recursively, so a file of 100000 '[' would overflow the stack), and
+/// counts the objects of the large top-level arrays so the model's vectors can be reserved.
+JsonOutline json_outline(const char* p, size_t n, size_t limit) {
+    JsonOutline o;
+    size_t depth = 0;
     bool in_string = false;
-    for (size_t i = 0; i < n && deepest <= limit; ++i) {
+    size_t string_start = 0;
+    std::string_view last_key;  // the last string closed at depth 1: a key of the root object
+    size_t* counter = nullptr;  // the count of the top-level array being scanned
+    auto counter_for = [&o](std::string_view key) -> size_t* {
+        if (key == "accessors") return &o.accessors;
+        if (key == "bufferViews") return &o.buffer_views;
+        if (key == "meshes") return &o.meshes;
+        if (key == "nodes") return &o.nodes;
+        if (key == "materials") return &o.materials;
+        return nullptr;
+    };
+    for (size_t i = 0; i < n && o.depth <= limit; ++i) {
         const char c = p[i];
         if (in_string) {
-            if (c == '\\') ++i;  // skip the escaped character
-            else if (c == '"') in_string = false;
+            if (c == '\\') {
+                ++i;  // skip the escaped character
+            } else if (c == '"') {
+                in_string = false;
+                if (depth == 1) last_key = std::string_view(p + string_start, i - string_start);
+            }
         } else if (c == '"') {
             in_string = true;
+            string_start = i + 1;
         } else if (c == '[' || c == '{') {
-            deepest = std::max(deepest, ++depth);
+            if (depth == 2 && c == '{' && counter != nullptr) ++*counter;
+            if (depth == 1 && c == '[') counter = counter_for(last_key);
+            o.depth = std::max(o.depth, ++depth);
         } else if ((c == ']' || c == '}') && depth > 0) {
-            --depth;
+            if (--depth == 1) counter = nullptr;
         }
     }
-    return deepest;
+    return o;
+}
+
+/// Room for `n` elements, when they fit the memory limit: tinygltf appends them one at a time
+/// (and only clears, never shrinks, the vectors first). A hint: without it the vector grows.
+template <typename T>
+void reserve_for(std::vector<T>& v, size_t n, size_t max_memory) {
+    if (n == 0 || n > max_memory / sizeof(T)) return;
+    try {
+        v.reserve(n);
+    } catch (const std::bad_alloc&) {
+    }
 }
 
 /// Shortens the payload of every data URI in a message ("data:...;base64,AAAA... (123456 chars)"):
@@ -411,8 +451,9 @@ private:
         // JSON nesting: the whole file, or the GLB JSON chunk (its length was checked above).
         const size_t json_offset = binary ? 20 : 0;
         const size_t json_size = binary ? size_t(load_u32(bytes.data() + 12)) : bytes.size();
-        if (json_depth(reinterpret_cast<const char*>(bytes.data()) + json_offset, json_size, kMaxJsonDepth) >
-            kMaxJsonDepth)
+        const JsonOutline outline =
+            json_outline(reinterpret_cast<const char*>(bytes.data()) + json_offset, json_size, kMaxJsonDepth);
+        if (outline.depth > kMaxJsonDepth)
             fail("", "invalid JSON: arrays/objects nested deeper than {} levels", kMaxJsonDepth);
 
         // A required extension whitted cannot honour is reported as that, before tinygltf gets to
@@ -434,6 +475,12 @@ private:
         m_uri_policy.base = m_base_dir;
         m_uri_policy.allow_outside = m_options.allow_outside_uris;
         m_uri_policy.max_bytes = m_options.max_memory;
+        // Reserved, the vectors are written once instead of moved through every doubling.
+        reserve_for(m_model.accessors, outline.accessors, m_options.max_memory);
+        reserve_for(m_model.bufferViews, outline.buffer_views, m_options.max_memory);
+        reserve_for(m_model.meshes, outline.meshes, m_options.max_memory);
+        reserve_for(m_model.nodes, outline.nodes, m_options.max_memory);
+        reserve_for(m_model.materials, outline.materials, m_options.max_memory);
         tinygltf::TinyGLTF parser;
         parser.SetImageLoader(&capture_image, &m_loader);
         parser.SetFsCallbacks(
@@ -984,7 +1031,7 @@ private:
 
     // ---- geometry -----------------------------------------------------------------------------
     /// Geometry of one primitive in object space (material and name set by the caller).
-    Mesh build_geometry(const tinygltf::Primitive& p, const std::string& ptr) {
+    Mesh build_geometry(const tinygltf::Primitive& p, const std::string& ptr, WarningLog& warnings) const {
         Mesh mesh;
         // Positions (finite: checked by validation).
         const AccessorData pos = accessor_data(m_model, p.attributes.at("POSITION"));
@@ -1033,7 +1080,7 @@ private:
             });
             need_generated = std::find(bad.begin(), bad.end(), 1) != bad.end();
             if (need_generated)
-                m_warnings.add("bad-normals",
+                warnings.add("bad-normals",
                                fmt::format("{}: zero or non-finite normals replaced by generated ones", ptr));
         }
         if (need_generated) {
@@ -1081,12 +1128,12 @@ private:
                 for (size_t i = 0; i < nv; ++i)
                     if (mesh.tangents[i].xyz() == Vec3f(0.f))
                         mesh.tangents[i] = Vec4f(any_perpendicular(mesh.normals[i]), 1.f);
-                m_warnings.add("bad-tangents", fmt::format("{}: zero or non-finite tangents replaced", ptr));
+                warnings.add("bad-tangents", fmt::format("{}: zero or non-finite tangents replaced", ptr));
             }
         } else if (tangent_uv >= 0) {
             const std::vector<Vec2f>& uv = tangent_uv == 0 ? mesh.uv0 : mesh.uv1;
             if (uv.empty())
-                m_warnings.add("normal-map-no-uv", fmt::format("{}: the normal texture uses TEXCOORD_{}, which the "
+                warnings.add("normal-map-no-uv", fmt::format("{}: the normal texture uses TEXCOORD_{}, which the "
                                                                "primitive lacks: no tangents, normal map has no effect",
                                                                ptr, tangent_uv));
             else
@@ -1132,35 +1179,74 @@ private:
 
     /// Geometry shared by every primitive with the same attribute and index accessors and mode
     /// (MetalRoughSpheres: 98 materials on one sphere) is decoded once.
-    using GeometryKey = std::tuple<std::map<std::string, int>, int, int, int>;
+    struct GeometryKey {
+        const std::map<std::string, int>* attributes;  ///< the primitive's, in m_model
+        int indices, mode, tangent_uv;
+        bool operator==(const GeometryKey& o) const {
+            return indices == o.indices && mode == o.mode && tangent_uv == o.tangent_uv && *attributes == *o.attributes;
+        }
+    };
+    struct GeometryKeyHash {
+        size_t operator()(const GeometryKey& k) const {
+            // Equal maps list equal accessors in the same (name) order: the names need no hashing.
+            uint64_t h = (uint64_t(uint32_t(k.indices)) << 32) ^ (uint64_t(uint32_t(k.mode)) << 8) ^ uint32_t(k.tangent_uv);
+            for (const auto& entry : *k.attributes) h = (h ^ uint32_t(entry.second)) * 0x100000001b3ull;
+            return size_t(h ^ (h >> 29));
+        }
+    };
 
     void build_meshes() {
-        std::map<GeometryKey, uint32_t> decoded;  // geometry -> first Scene mesh holding it
-        m_scene.meshes.reserve(m_requests.size());
-        for (const MeshKey& k : m_requests) {
-            const tinygltf::Mesh& gm = m_model.meshes[size_t(k.mesh)];
-            const tinygltf::Primitive& p = gm.primitives[size_t(k.primitive)];
-            const std::string ptr = fmt::format("/meshes/{}/primitives/{}", k.mesh, k.primitive);
+        // Which request decodes its geometry and which copies an earlier request's.
+        const size_t n = m_requests.size();
+        std::unordered_map<GeometryKey, uint32_t, GeometryKeyHash> decoded;  // geometry -> first request
+        decoded.reserve(n);
+        std::vector<uint32_t> source(n);  // request -> the request whose geometry it uses
+        std::vector<uint32_t> unique;     // requests that decode, in order
+        for (size_t i = 0; i < n; ++i) {
+            const tinygltf::Primitive& p = primitive(m_requests[i]);
             const int tangent_uv =
                 needs_tangents(p) ? int(m_scene.materials[size_t(p.material)].normal_texture.uv_set) : -1;
-            const GeometryKey gkey{p.attributes, p.indices, p.mode, tangent_uv};
+            const auto [it, inserted] = decoded.emplace(GeometryKey{&p.attributes, p.indices, p.mode, tangent_uv},
+                                                        uint32_t(i));
+            source[i] = it->second;
+            if (inserted) unique.push_back(uint32_t(i));
+        }
+
+        // Decode on all cores; each geometry's warnings are kept apart and appended below in
+        // request order, so the log is the same for any thread count.
+        std::vector<Mesh> built(unique.size());
+        std::vector<WarningLog> logs(unique.size());
+        tbb::parallel_for(size_t(0), unique.size(), [&](size_t u) {
+            const MeshKey& k = m_requests[unique[u]];
+            const std::string ptr = fmt::format("/meshes/{}/primitives/{}", k.mesh, k.primitive);
+            built[u] = build_geometry(primitive(k), ptr, logs[u]);
+            report_mesh_numbers(sanitize_mesh_numbers(built[u]), ptr, logs[u]);
+            if (k.mirrored) mirror(built[u]);
+        });
+
+        m_scene.meshes.reserve(n);
+        for (size_t i = 0, u = 0; i < n; ++i) {
+            const MeshKey& k = m_requests[i];
+            const tinygltf::Mesh& gm = m_model.meshes[size_t(k.mesh)];
             Mesh mesh;
-            if (auto it = decoded.find(gkey); it != decoded.end()) {
-                const Mesh& src = m_scene.meshes[it->second];
-                mesh = src;
-                if (m_requests[it->second].mirrored != k.mirrored) mirror(mesh);
+            if (source[i] == i) {
+                m_warnings.append(logs[u]);
+                mesh = std::move(built[u++]);
             } else {
-                mesh = build_geometry(p, ptr);
-                report_mesh_numbers(sanitize_mesh_numbers(mesh), ptr, m_warnings);
-                if (k.mirrored) mirror(mesh);
-                decoded.emplace(gkey, uint32_t(m_scene.meshes.size()));
+                mesh = m_scene.meshes[source[i]];
+                if (m_requests[source[i]].mirrored != k.mirrored) mirror(mesh);
             }
             mesh.name = fmt::format("{}/{}", gm.name.empty() ? fmt::format("mesh {}", k.mesh) : gm.name, k.primitive);
             if (k.mirrored) mesh.name += " (mirrored)";
-            mesh.material = p.material >= 0 ? uint32_t(p.material) : default_material();
+            const int material = gm.primitives[size_t(k.primitive)].material;
+            mesh.material = material >= 0 ? uint32_t(material) : default_material();
             m_scene.meshes.push_back(std::move(mesh));
         }
         if (m_scene.materials.empty()) default_material();
+    }
+
+    const tinygltf::Primitive& primitive(const MeshKey& k) const {
+        return m_model.meshes[size_t(k.mesh)].primitives[size_t(k.primitive)];
     }
 
     /// The copy of a mesh for transforms with a negative determinant: glTF says such a transform
@@ -1230,8 +1316,8 @@ private:
 }  // namespace
 
 Scene import_gltf(const std::string& path, const ImportOptions& options) {
-    const std::vector<uint8_t> bytes = read_file(path, options.max_memory);
-    return GltfImporter(path, options).run(bytes);
+    const FileBytes bytes = read_file(path, options.max_memory);
+    return GltfImporter(path, options).run(bytes.bytes());
 }
 
 Scene import_gltf_memory(std::span<const uint8_t> bytes, const std::string& path, const ImportOptions& options) {

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <string>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <tiny_gltf.h>
@@ -13,8 +14,9 @@
 namespace whitted::gltf {
 
 /// The member `key` of an extension map, or nullptr.
-inline const tinygltf::Value* find_extension(const tinygltf::ExtensionMap& extensions, const std::string& key) {
-    auto it = extensions.find(key);
+inline const tinygltf::Value* find_extension(const tinygltf::ExtensionMap& extensions, std::string_view key) {
+    if (extensions.empty()) return nullptr;  // most objects: no std::string key built for the lookup
+    auto it = extensions.find(std::string(key));
     return it == extensions.end() ? nullptr : &it->second;
 }
 

@@ -61,6 +61,7 @@ bool add_meshopt_fallback_uris(nlohmann::json& doc, bool binary) {
 void decode_meshopt_views(tinygltf::Model& model, const std::string& path) {
     for (size_t i = 0; i < model.bufferViews.size(); ++i) {
         const tinygltf::BufferView& view = model.bufferViews[i];
+        if (view.extensions.empty()) continue;
         const auto found = view.extensions.find(kExt);
         if (found == view.extensions.end()) continue;
         const tinygltf::Value& ext = found->second;

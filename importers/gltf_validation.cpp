@@ -3,8 +3,10 @@
 
 #include "importers/gltf_validation.h"
 
+#include <array>
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <string_view>
 #include <unordered_map>
 #include <vector>
@@ -60,6 +62,56 @@ int attribute_set(std::string_view name, std::string_view prefix) {
     return v;
 }
 
+/// A JSON pointer kept in pieces and joined only when an error or warning needs its text: the
+/// checks run per accessor, bufferView, node and primitive, and formatting every pointer of a
+/// 100,000-node file up front cost more than the checks. Appended pieces are views, so each
+/// must outlive the Pointer (literals and strings of the model do).
+class Pointer {
+public:
+    Pointer(const char* text) : m_head(text) {}
+    Pointer(std::string text) : m_head(std::move(text)) {}
+
+    Pointer operator+(std::string_view piece) const {
+        Pointer p = *this;
+        if (!piece.empty()) p.append({piece.data(), piece.size()});
+        return p;
+    }
+    Pointer operator+(size_t index) const {
+        Pointer p = *this;
+        p.append({nullptr, index});
+        return p;
+    }
+
+    std::string text() const {
+        std::string out = m_head;
+        for (size_t i = 0; i < m_count; ++i) {
+            const Piece& piece = m_pieces[i];
+            if (piece.text == nullptr)
+                out += std::to_string(piece.value);
+            else
+                out.append(piece.text, piece.value);
+        }
+        return out;
+    }
+
+private:
+    struct Piece {
+        const char* text;  ///< nullptr: an index
+        size_t value;      ///< the text's length, or the index
+    };
+    void append(const Piece& piece) {
+        if (m_count == m_pieces.size()) {  // full: join what there is into the head
+            m_head = text();
+            m_count = 0;
+        }
+        m_pieces[m_count++] = piece;
+    }
+
+    std::string m_head;
+    std::array<Piece, 8> m_pieces{};
+    size_t m_count = 0;
+};
+
 class Validator {
 public:
     Validator(const tinygltf::Model& model, const std::string& file, size_t max_memory, Scene& scene)
@@ -87,17 +139,17 @@ public:
 
 private:
     template <typename... Args>
-    [[noreturn]] void fail(const std::string& pointer, fmt::format_string<Args...> f, Args&&... args) const {
-        throw Error(file_loc(m_file, pointer), fmt::format(f, std::forward<Args>(args)...));
+    [[noreturn]] void fail(const Pointer& pointer, fmt::format_string<Args...> f, Args&&... args) const {
+        throw Error(file_loc(m_file, pointer.text()), fmt::format(f, std::forward<Args>(args)...));
     }
 
     /// An index into an array of `size` objects named `what` ("mesh", "accessor").
-    void check_ref(int index, size_t size, const std::string& pointer, const char* what) const {
+    void check_ref(int index, size_t size, const Pointer& pointer, const char* what) const {
         if (index < 0 || size_t(index) >= size)
             fail(pointer, "unresolved reference: {} {} does not exist (the file has {})", what, index, size);
     }
 
-    void check_finite(double v, const std::string& pointer) const {
+    void check_finite(double v, const Pointer& pointer) const {
         if (!std::isfinite(v)) fail(pointer, "value {} is not a finite number", v);
     }
 
@@ -117,7 +169,7 @@ private:
     void check_buffer_views() const {
         for (size_t i = 0; i < m_model.bufferViews.size(); ++i) {
             const tinygltf::BufferView& bv = m_model.bufferViews[i];
-            const std::string ptr = fmt::format("/bufferViews/{}", i);
+            const Pointer ptr = Pointer("/bufferViews/") + i;
             check_ref(bv.buffer, m_model.buffers.size(), ptr + "/buffer", "buffer");
             const size_t buffer_size = m_model.buffers[size_t(bv.buffer)].data.size();
             if (bv.byteLength < 1) fail(ptr + "/byteLength", "byteLength must be at least 1");
@@ -138,7 +190,7 @@ private:
     // ---- accessors ------------------------------------------------------------------------------
     void check_accessor(int index) {
         const tinygltf::Accessor& a = m_model.accessors[size_t(index)];
-        const std::string ptr = fmt::format("/accessors/{}", index);
+        const Pointer ptr = Pointer("/accessors/") + size_t(index);
         const int csize = component_size(a.componentType);
         if (csize == 0) fail(ptr + "/componentType", "invalid componentType {}", a.componentType);
         const int ncomp = component_count(a.type);
@@ -223,7 +275,6 @@ private:
     void check_bounds(int index, const tinygltf::Accessor& a) {
         // Elements outside the declared min/max (glTF-Validator ACCESSOR_ELEMENT_OUT_OF_*_BOUND).
         // Floats get a small tolerance for writers that print rounded bounds.
-        const std::string ptr = fmt::format("/accessors/{}", index);
         AccessorData d = accessor_data(m_model, index);
         if (d.base == nullptr) d.count = std::min<size_t>(d.count, 1);  // implicit zeros: one is enough
         const bool is_float = a.componentType == kFloat;
@@ -251,7 +302,7 @@ private:
         });
         if (bad) {
             const double bound = bad_is_min ? a.minValues[size_t(bad_component)] : a.maxValues[size_t(bad_component)];
-            fail(fmt::format("{}/{}/{}", ptr, bad_is_min ? "min" : "max", bad_component),
+            fail(fmt::format("/accessors/{}/{}/{}", index, bad_is_min ? "min" : "max", bad_component),
                  "element {} component {} is {}, outside the declared {} {}", bad_element, bad_component, bad_value,
                  bad_is_min ? "minimum" : "maximum", bound);
         }
@@ -269,7 +320,7 @@ private:
 
     // ---- meshes ---------------------------------------------------------------------------------
     /// Checks an attribute's accessor type against what glTF (with KHR_mesh_quantization) allows.
-    void check_attribute_format(const std::string& name, const tinygltf::Accessor& a, const std::string& ptr) const {
+    void check_attribute_format(const std::string& name, const tinygltf::Accessor& a, const Pointer& ptr) const {
         const int ct = a.componentType;
         const bool fl = ct == kFloat;
         const bool int8_16 = ct == kByte || ct == kUnsignedByte || ct == kShort || ct == kUnsignedShort;
@@ -304,14 +355,14 @@ private:
             m_warnings.add("no-primitives", fmt::format("/meshes/{}: mesh has no primitives", m));
         for (size_t p = 0; p < mesh.primitives.size(); ++p) {
             const tinygltf::Primitive& prim = mesh.primitives[p];
-            const std::string ptr = fmt::format("/meshes/{}/primitives/{}", m, p);
+            const Pointer ptr = Pointer("/meshes/") + size_t(m) + "/primitives/" + p;
             // References and formats of every attribute; equal counts (MESH_PRIMITIVE_UNEQUAL_ACCESSOR_COUNT).
             const int count_accessor = vertex_count_accessor(prim);
             size_t vertex_count = 0;
             if (count_accessor >= 0 && size_t(count_accessor) < m_model.accessors.size())
                 vertex_count = m_model.accessors[size_t(count_accessor)].count;
             for (const auto& [name, acc] : prim.attributes) {
-                const std::string aptr = ptr + "/attributes/" + name;
+                const Pointer aptr = ptr + "/attributes/" + name;
                 check_ref(acc, m_model.accessors.size(), aptr, "accessor");
                 const tinygltf::Accessor& a = m_model.accessors[size_t(acc)];
                 check_attribute_format(name, a, aptr);
@@ -346,7 +397,7 @@ private:
             }
             for (size_t t = 0; t < prim.targets.size(); ++t)
                 for (const auto& [name, acc] : prim.targets[t]) {
-                    const std::string tptr = fmt::format("{}/targets/{}/{}", ptr, t, name);
+                    const Pointer tptr = ptr + "/targets/" + t + "/" + name;
                     check_ref(acc, m_model.accessors.size(), tptr, "accessor");
                     if (m_model.accessors[size_t(acc)].count != vertex_count)
                         fail(tptr, "morph target accessor count {} differs from the vertex count {}",
@@ -361,21 +412,21 @@ private:
                 continue;
             }
             if (prim.attributes.find("POSITION") == prim.attributes.end()) {
-                m_warnings.add("no-position", fmt::format("{}: primitive has no POSITION attribute: skipped", ptr));
+                m_warnings.add("no-position", fmt::format("{}: primitive has no POSITION attribute: skipped", ptr.text()));
                 continue;
             }
             if (prim.mode == TINYGLTF_MODE_TRIANGLES && element_count % 3 != 0)
                 m_warnings.add("incompatible-count",
                                fmt::format("{}: TRIANGLES primitive with {} vertices/indices (not a multiple of 3): "
                                            "the last {} dropped",
-                                           ptr, element_count, element_count % 3));
+                                           ptr.text(), element_count, element_count % 3));
             if (triangle_count_for_mode(prim.mode, element_count) == 0)
                 m_warnings.add("too-few",
-                               fmt::format("{}: primitive has fewer than 3 vertices/indices: no triangles", ptr));
+                               fmt::format("{}: primitive has fewer than 3 vertices/indices: no triangles", ptr.text()));
         }
     }
 
-    void check_finite_data(int accessor, const std::string& ptr) {
+    void check_finite_data(int accessor, const Pointer& ptr) {
         if (!m_finite_checked.emplace(accessor, true).second) return;
         AccessorData d = accessor_data(m_model, accessor);
         if (d.base == nullptr) d.count = 0;  // implicit zeros are finite: only sparse values to check
@@ -586,7 +637,7 @@ private:
         std::vector<int> parent(n, -1);
         for (size_t i = 0; i < n; ++i) {
             const tinygltf::Node& node = m_model.nodes[i];
-            const std::string ptr = fmt::format("/nodes/{}", i);
+            const Pointer ptr = Pointer("/nodes/") + i;
             if (node.mesh != -1) check_ref(node.mesh, m_model.meshes.size(), ptr + "/mesh", "mesh");
             if (node.camera != -1) check_ref(node.camera, m_model.cameras.size(), ptr + "/camera", "camera");
             if (node.skin != -1) check_ref(node.skin, m_model.skins.size(), ptr + "/skin", "skin");
@@ -601,7 +652,7 @@ private:
                 check_gpu_instancing(gi, ptr + "/extensions/EXT_mesh_gpu_instancing");
             for (size_t c = 0; c < node.children.size(); ++c) {
                 const int child = node.children[c];
-                const std::string cptr = fmt::format("{}/children/{}", ptr, c);
+                const Pointer cptr = ptr + "/children/" + c;
                 check_ref(child, n, cptr, "node");
                 if (size_t(child) == i) fail(cptr, "node {} is its own child", i);
                 if (parent[size_t(child)] != -1)
@@ -628,11 +679,12 @@ private:
         m_parent = std::move(parent);
     }
 
-    void check_transform(const tinygltf::Node& node, const std::string& ptr) const {
+    void check_transform(const tinygltf::Node& node, const Pointer& ptr) const {
         auto check_array = [&](const std::vector<double>& v, size_t want, const char* key) {
             if (v.empty()) return;
             if (v.size() != want) fail(ptr + "/" + key, "{} needs {} numbers, has {}", key, want, v.size());
-            for (size_t k = 0; k < v.size(); ++k) check_finite(v[k], fmt::format("{}/{}/{}", ptr, key, k));
+            for (size_t k = 0; k < v.size(); ++k)
+                if (!std::isfinite(v[k])) check_finite(v[k], ptr + "/" + key + "/" + k);
         };
         check_array(node.matrix, 16, "matrix");
         check_array(node.translation, 3, "translation");
@@ -645,13 +697,13 @@ private:
         }
     }
 
-    void check_gpu_instancing(const tinygltf::Value* ext, const std::string& ptr) {
+    void check_gpu_instancing(const tinygltf::Value* ext, const Pointer& ptr) {
         const tinygltf::Value* attrs = find_member(ext, "attributes");
         if (attrs == nullptr || !attrs->IsObject()) fail(ptr + "/attributes", "attributes object missing");
         size_t count = 0;
         bool first = true;
         for (const std::string& name : attrs->Keys()) {
-            const std::string aptr = ptr + "/attributes/" + name;
+            const Pointer aptr = ptr + "/attributes/" + name;
             int acc = -1;
             if (!as_int(&attrs->Get(name), acc)) fail(aptr, "attribute is not an accessor index");
             check_ref(acc, m_model.accessors.size(), aptr, "accessor");
@@ -680,7 +732,7 @@ private:
         for (size_t s = 0; s < m_model.scenes.size(); ++s) {
             const auto& roots = m_model.scenes[s].nodes;
             for (size_t k = 0; k < roots.size(); ++k) {
-                const std::string ptr = fmt::format("/scenes/{}/nodes/{}", s, k);
+                const Pointer ptr = Pointer("/scenes/") + s + "/nodes/" + k;
                 check_ref(roots[k], m_model.nodes.size(), ptr, "node");
                 if (m_parent[size_t(roots[k])] != -1)
                     fail(ptr, "node {} is listed as a scene root but is a child of node {}", roots[k],

@@ -16,11 +16,12 @@ class WarningLog {
 public:
     /// Records `message` under `kind`; only the first message of a kind is kept verbatim.
     void add(const std::string& kind, const std::string& message) {
-        auto [it, inserted] = m_index.emplace(kind, m_entries.size());
-        if (inserted)
-            m_entries.push_back({message, 1});
-        else
-            ++m_entries[it->second].count;
+        add(kind, message, 1);
+    }
+
+    /// Records every kind of `other` as if its messages were added here, in its order.
+    void append(const WarningLog& other) {
+        for (const Entry& e : other.m_entries) add(e.kind, e.first, e.count);
     }
 
     /// Moves every kind into scene.warnings, in first-seen order, and clears the log.
@@ -33,9 +34,19 @@ public:
 
 private:
     struct Entry {
+        std::string kind;
         std::string first;
         size_t count = 0;
     };
+
+    void add(const std::string& kind, const std::string& message, size_t count) {
+        auto [it, inserted] = m_index.emplace(kind, m_entries.size());
+        if (inserted)
+            m_entries.push_back({kind, message, count});
+        else
+            m_entries[it->second].count += count;
+    }
+
     std::vector<Entry> m_entries;
     std::unordered_map<std::string, size_t> m_index;
 };

@@ -741,6 +741,18 @@ TEST(GltfHandMade, NodeThatIsItsOwnChildAndNonRootSceneNode) {
     EXPECT_NE(error_text([&] { load_scene(path); }).find("/scenes/0/nodes/1"), std::string::npos);
 }
 
+TEST(GltfHandMade, ErrorPointersJoinEveryIndex) {
+    // Twelve nodes, the last faulty: its pointer has a two-digit index (joined from pieces).
+    std::string nodes = R"("nodes": [{"mesh": 0})";
+    for (int i = 1; i < 12; ++i) nodes += i == 11 ? R"(, {"children": [1, 13]})" : R"(, {})";
+    const std::string path = write_gltf("pointer_indices.gltf", edit(kQuadJson, R"("nodes": [{"mesh": 0}])", nodes + "]"),
+                                        quad_bin());
+    const std::string err = error_text([&] { load_scene(path); });
+    EXPECT_NE(err.find(path + ": /nodes/11/children/1: unresolved reference: node 13 does not exist (the file has 12)"),
+              std::string::npos)
+        << err;
+}
+
 TEST(GltfHandMade, HugeAccessorCountOverTinyBuffer) {
     const std::string path = write_gltf(
         "huge_count.gltf",
