@@ -37,6 +37,12 @@ bool only_prints(char** argv) {
     return false;
 }
 
+/// Under valgrind /proc/self/exe is the tool, not the program: never restart there.
+bool under_valgrind() {
+    const char* preload = std::getenv("LD_PRELOAD");
+    return preload != nullptr && std::strstr(preload, "vgpreload") != nullptr;
+}
+
 }  // namespace
 
 bool huge_pages_requested() {
@@ -46,7 +52,7 @@ bool huge_pages_requested() {
 }
 
 void restart_with_huge_pages(char** argv) {
-    if (tunable_given() || only_prints(argv)) return;
+    if (tunable_given() || only_prints(argv) || under_valgrind()) return;
     if (const char* opt = std::getenv("WHITTED_HUGE_PAGES"); opt != nullptr && std::strcmp(opt, "0") == 0) return;
     if (!kernel_offers_huge_pages()) return;
     const char* old = std::getenv("GLIBC_TUNABLES");

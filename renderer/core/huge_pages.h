@@ -7,7 +7,7 @@ namespace whitted {
 /// GLIBC_TUNABLES gaining glibc.malloc.hugetlb=1, so that malloc asks the kernel for transparent
 /// huge pages: a large buffer then faults in 2 MiB at a time instead of 4 KiB. Does nothing and
 /// returns when the kernel offers no transparent huge pages, when GLIBC_TUNABLES already sets
-/// the tunable (to any value), when WHITTED_HUGE_PAGES=0, for runs that only print (--help,
+/// the tunable (to any value), when WHITTED_HUGE_PAGES=0, under valgrind, for runs that only print (--help,
 /// --version, no arguments), or when exec fails. Call first thing in main(), before
 /// any thread or library state exists.
 void restart_with_huge_pages(char** argv);

@@ -16,12 +16,11 @@ struct EmbreeConfig {
     int packet_width = 4;  ///< batch closest-hit queries: rays per rtcIntersect4/8/16 packet, 1 = rtcIntersect1 each
     bool compact = false;  ///< RTC_SCENE_FLAG_COMPACT: leaves index the vertices instead of copying them
                            ///< (less memory, slower camera rays; docs/performance.md)
-    /// `embree:flatten=1`, experimental and off by default: a mesh that one instance alone uses
-    /// (with a transform that keeps orientation) goes into the top-level scene in world space, so
-    /// one BVH holds all such meshes' triangles instead of a BVH of instances over overlapping
-    /// bounds; meshes used more than once stay instanced. Faster on interlocking meshes, but it
-    /// fails the energy-bound check on one pixel of default.glb (docs/accelerators.md "Instances").
-    bool flatten = false;
+    /// A mesh that one instance alone uses (with a transform that keeps orientation) goes into the
+    /// top-level scene in world space, so one BVH holds all such meshes' triangles instead of a
+    /// BVH of instances over overlapping bounds; meshes used more than once stay instanced
+    /// (docs/accelerators.md "Instances"). `embree:flatten=0`: every mesh instanced.
+    bool flatten = true;
 };
 
 /// Ceiling on the bytes all Embree devices may hold at once (enforced by the device memory
