@@ -188,13 +188,13 @@ void write_exr_file(const std::string& path, const ImageDesc& desc, const void* 
     const Imath::Box2i display(Imath::V2i(desc.full_x, desc.full_y), Imath::V2i(desc.full_x + fw - 1, desc.full_y + fh - 1));
     try {
         Imf::Header header(display, data);
-        // "zip" or "zip:N" (OIIO's spelling of a zlib level). Level 3 by default: measured on a
-        // 1920x1080 half beauty, 50 ms and 903 KB against OpenEXR's default 4 (62 ms, 831 KB) and
-        // 6 (93 ms, 759 KB) (benchmarks/bench_output.cpp, docs/measurements/performance.md).
+        // "zip" or "zip:N" (OIIO's spelling of a zlib level). Level 1 by default, chosen by
+        // measurement on a 1920x1080 half beauty (benchmarks/bench_output.cpp,
+        // docs/measurements/performance.md "Output"): 10 % larger than level 3 at 3/4 of the time.
         const std::string compression = desc.attribute("compression");
         const size_t colon = compression.find(':');
         header.compression() = compression_from(compression.substr(0, colon));
-        header.zipCompressionLevel() = 3;
+        header.zipCompressionLevel() = 1;
         if (colon != std::string::npos) {
             const int level = std::atoi(compression.c_str() + colon + 1);
             if (level >= 1 && level <= 9) header.zipCompressionLevel() = level;
