@@ -14,6 +14,9 @@ namespace whitted {
 namespace {
 
 constexpr const char* kTunable = "glibc.malloc.hugetlb=1";
+/// Set for the second start: "-" when GLIBC_TUNABLES was unset before, else "=" and its value.
+constexpr const char* kRestarted = "WHITTED_HUGE_PAGES_RESTARTED";
+bool g_restarted = false;
 
 /// The kernel's THP mode is "always" or "madvise" (not "never", and the file exists).
 bool kernel_offers_huge_pages() {
@@ -46,21 +49,38 @@ bool under_valgrind() {
 }  // namespace
 
 bool huge_pages_requested() {
+    if (g_restarted) return true;
     const char* t = std::getenv("GLIBC_TUNABLES");
     const char* at = t != nullptr ? std::strstr(t, "glibc.malloc.hugetlb=") : nullptr;
     return at != nullptr && at[std::strlen("glibc.malloc.hugetlb=")] != '0';
 }
 
 void restart_with_huge_pages(char** argv) {
+    // The second start: glibc has read the tunable; the environment goes back to what the user
+    // gave, so that processes started from here (bench process, helpers) see it unchanged.
+    if (const char* marker = std::getenv(kRestarted)) {
+        g_restarted = true;
+        const std::string before = marker;
+        ::unsetenv(kRestarted);
+        if (before.size() > 0 && before[0] == '=') ::setenv("GLIBC_TUNABLES", before.c_str() + 1, 1);
+        else ::unsetenv("GLIBC_TUNABLES");
+        return;
+    }
     if (tunable_given() || only_prints(argv) || under_valgrind()) return;
     if (const char* opt = std::getenv("WHITTED_HUGE_PAGES"); opt != nullptr && std::strcmp(opt, "0") == 0) return;
     if (!kernel_offers_huge_pages()) return;
     const char* old = std::getenv("GLIBC_TUNABLES");
     const std::string tunables = (old != nullptr && old[0] != '\0') ? std::string(old) + ":" + kTunable : kTunable;
-    if (::setenv("GLIBC_TUNABLES", tunables.c_str(), 1) != 0) return;
+    const std::string saved = old != nullptr ? std::string("=") + old : std::string("-");
+    if (::setenv(kRestarted, saved.c_str(), 1) != 0) return;
+    if (::setenv("GLIBC_TUNABLES", tunables.c_str(), 1) != 0) {
+        ::unsetenv(kRestarted);
+        return;
+    }
     ::execv("/proc/self/exe", argv);
     // exec failed: go on as we are, with the environment as it was.
-    if (old != nullptr) ::setenv("GLIBC_TUNABLES", old, 1);
+    ::unsetenv(kRestarted);
+    if (old != nullptr) ::setenv("GLIBC_TUNABLES", saved.c_str() + 1, 1);
     else ::unsetenv("GLIBC_TUNABLES");
 }
 
