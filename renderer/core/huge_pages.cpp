@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -40,6 +41,20 @@ bool only_prints(char** argv) {
     return false;
 }
 
+/// Every file named on the command line is a scene file (.json) under 1 MiB: a run that touches
+/// a few megabytes, where huge pages cost more (2 MiB zeroed per first touch) than they save.
+bool only_small_scene_files(char** argv) {
+    bool any = false;
+    for (char** a = argv + 1; *a != nullptr; ++a) {
+        std::error_code ec;
+        const std::filesystem::path p(*a);
+        if (!std::filesystem::is_regular_file(p, ec)) continue;
+        any = true;
+        if (p.extension() != ".json" || std::filesystem::file_size(p, ec) >= (size_t(1) << 20) || ec) return false;
+    }
+    return any;
+}
+
 /// Under valgrind /proc/self/exe is the tool, not the program: never restart there.
 bool under_valgrind() {
     const char* preload = std::getenv("LD_PRELOAD");
@@ -66,7 +81,7 @@ void restart_with_huge_pages(char** argv) {
         else ::unsetenv("GLIBC_TUNABLES");
         return;
     }
-    if (tunable_given() || only_prints(argv) || under_valgrind()) return;
+    if (tunable_given() || only_prints(argv) || only_small_scene_files(argv) || under_valgrind()) return;
     if (const char* opt = std::getenv("WHITTED_HUGE_PAGES"); opt != nullptr && std::strcmp(opt, "0") == 0) return;
     if (!kernel_offers_huge_pages()) return;
     const char* old = std::getenv("GLIBC_TUNABLES");
