@@ -77,19 +77,25 @@ void BM_EncodePng(benchmark::State& state) {
 }
 BENCHMARK(BM_EncodePng)->DenseRange(0, 9)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+/// The film's RGB as one writer takes it: every channel of type `type`, with `compression`.
+ImageDesc rgb_desc(const char* format, PixelType type, const std::string& compression) {
+    ImageDesc desc;
+    desc.format_name = format;
+    desc.width = film().width();
+    desc.height = film().height();
+    desc.channel_names = {"R", "G", "B"};
+    desc.channel_types.assign(3, type);
+    desc.attributes = {{"compression", compression}};
+    return desc;
+}
+
 void write_exr_half(benchmark::State& state, const std::string& compression) {
     // The beauty as half, as write_image writes it, with the given compression.
     std::vector<Imath::half> half;
     half.reserve(film().beauty.size() * 3);
     for (const Color& c : film().beauty)
         for (float v : {c.x, c.y, c.z}) half.emplace_back(v);
-    ImageDesc desc;
-    desc.format_name = "openexr";
-    desc.width = film().width();
-    desc.height = film().height();
-    desc.channel_names = {"R", "G", "B"};
-    desc.channel_types.assign(3, PixelType::Half);
-    desc.attributes = {{"compression", compression}};
+    const ImageDesc desc = rgb_desc("openexr", PixelType::Half, compression);
     const fs::path file = scratch(".exr");
     for (auto _ : state) write_image_file(file.string(), desc, half.data());
     state.counters["bytes"] = double(fs::file_size(file));
@@ -106,13 +112,7 @@ void BM_WriteTiff16Level(benchmark::State& state) {
     // 16-bit display codes as write_image makes them for TIFF, deflate level N.
     std::vector<uint8_t> codes16(film().beauty.size() * 6);
     display_codes(film().beauty, DisplayTransform(ColorSettings{}), 16, codes16);
-    ImageDesc desc;
-    desc.format_name = "tiff";
-    desc.width = film().width();
-    desc.height = film().height();
-    desc.channel_names = {"R", "G", "B"};
-    desc.channel_types.assign(3, PixelType::UInt16);
-    desc.attributes = {{"compression", "zip:" + std::to_string(state.range(0))}};
+    const ImageDesc desc = rgb_desc("tiff", PixelType::UInt16, "zip:" + std::to_string(state.range(0)));
     const fs::path file = scratch(".tif");
     for (auto _ : state) write_image_file(file.string(), desc, codes16.data());
     state.counters["bytes"] = double(fs::file_size(file));

@@ -58,6 +58,15 @@ std::vector<uint8_t> test_codes(int w, int h, int bits, uint32_t seed) {
     return out;
 }
 
+/// A w x h film of random values across the display range and beyond it.
+Film random_film(int w, int h, uint32_t seed) {
+    Film film(w, h, PixelWindow{0, 0, w, h}, AovSet{});
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-0.1f, 1.6f);
+    for (Color& c : film.beauty) c = Color(u(rng), u(rng), u(rng));
+    return film;
+}
+
 struct Decoded {
     OIIO::ImageSpec spec;
     std::vector<uint8_t> codes;  ///< native layout, as encode_png takes them
@@ -139,10 +148,7 @@ TEST(PngEncoder, RejectsBadArguments) {
 TEST(PngEncoder, WriteImageStoresExactlyTheDisplayCodes) {
     // A film with values across the range (and beyond it): the PNG holds display_codes' bytes.
     const int w = 97, h = 61;
-    Film film(w, h, PixelWindow{0, 0, w, h}, AovSet{});
-    std::mt19937 rng(3);
-    std::uniform_real_distribution<float> u(-0.1f, 1.6f);
-    for (Color& c : film.beauty) c = Color(u(rng), u(rng), u(rng));
+    const Film film = random_film(w, h, 3);
     for (int bits : {8, 16}) {
         OutputSettings settings;
         settings.bits = bits;
@@ -162,10 +168,7 @@ TEST(PngEncoder, WriteImageStoresExactlyTheDisplayCodes) {
 TEST(TiffWriter, StoresExactlyTheDisplayCodesForAnySize) {
     // Heights that leave a partial strip (strips of 32 rows), one-pixel-wide images, 8 and 16 bits.
     for (auto [w, h] : {std::pair{97, 61}, std::pair{1, 33}, std::pair{40, 32}, std::pair{3, 1}}) {
-        Film film(w, h, PixelWindow{0, 0, w, h}, AovSet{});
-        std::mt19937 rng(uint32_t(w * 1000 + h));
-        std::uniform_real_distribution<float> u(-0.1f, 1.6f);
-        for (Color& c : film.beauty) c = Color(u(rng), u(rng), u(rng));
+        const Film film = random_film(w, h, uint32_t(w * 1000 + h));
         for (int bits : {8, 16}) {
             OutputSettings settings;
             settings.bits = bits;
