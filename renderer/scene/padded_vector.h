@@ -31,7 +31,7 @@ struct TailPaddedAllocator {
         std::memset(p, 0, n * sizeof(T) + kTailBytes);
         return static_cast<T*>(p);
     }
-    void deallocate(T* p, size_t n) noexcept { ::operator delete(p, n * sizeof(T) + kTailBytes); }
+    void deallocate(T* p, size_t) noexcept { ::operator delete(p); }  // unsized: clang declares no sized delete by default
 
     template <typename U>
     bool operator==(const TailPaddedAllocator<U, kTailBytes>&) const noexcept {
