@@ -42,6 +42,7 @@
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/accel/bvh/bvh_tree.h"
+#include "renderer/accel/common/flatten.h"
 #include "renderer/accel/common/geometry.h"
 #include "renderer/accel/common/primitives.h"
 #include "renderer/accel/common/queries.h"
@@ -273,21 +274,14 @@ private:
         }
     };
 
-    /// Per instance: whether it goes into the flat BLAS (its mesh used by it alone, with
-    /// triangles, and a transform that keeps orientation); all 0 unless at least two qualify.
+    /// Per instance: whether it goes into the flat BLAS (its mesh flattenable_meshes()); all 0
+    /// unless at least two qualify (one alone gains nothing from sharing a BLAS).
     static std::vector<uint8_t> flattened_instances(const Scene& scene, bool flatten) {
         std::vector<uint8_t> flat(scene.instances.size(), 0);
         if (!flatten) return flat;
-        std::vector<uint32_t> uses(scene.meshes.size(), 0);
-        for (const Instance& inst : scene.instances)
-            if (inst.mesh < uses.size()) ++uses[inst.mesh];
         size_t count = 0;
-        for (size_t i = 0; i < scene.instances.size(); ++i) {
-            const Instance& inst = scene.instances[i];
-            if (inst.mesh < uses.size() && uses[inst.mesh] == 1 && scene.meshes[inst.mesh].triangle_count() > 0 &&
-                inst.world_from_object.det3() > 0.0)
-                flat[i] = 1, ++count;
-        }
+        for (int64_t i : flattenable_meshes(scene))
+            if (i >= 0) flat[size_t(i)] = 1, ++count;
         if (count < 2) flat.assign(flat.size(), 0);
         return flat;
     }

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "renderer/accel/common/flatten.h"
 #include "renderer/accel/common/geometry.h"
 #include "renderer/accel/common/primitives.h"
 #include "renderer/accel/embree/embree_ray.h"
@@ -271,18 +272,9 @@ public:
         const RTCSceneFlags flags = RTCSceneFlags((config.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE) |
                                                   (config.compact ? RTC_SCENE_FLAG_COMPACT : RTC_SCENE_FLAG_NONE));
 
-        // Which meshes are flattened: used by exactly one instance whose transform keeps the
-        // orientation (a mirroring one would flip the winding Embree's Ng follows).
-        std::vector<uint32_t> uses(scene.meshes.size(), 0);
-        for (const Instance& inst : scene.instances)
-            if (inst.mesh < uses.size()) ++uses[inst.mesh];
-        std::vector<int64_t> flat_instance(scene.meshes.size(), -1);  ///< the instance a flattened mesh is placed by
-        if (config.flatten)
-            for (size_t i = 0; i < scene.instances.size(); ++i) {
-                const Instance& inst = scene.instances[i];
-                if (inst.mesh < uses.size() && uses[inst.mesh] == 1 && inst.world_from_object.det3() > 0.0)
-                    flat_instance[inst.mesh] = int64_t(i);
-            }
+        // Which meshes are flattened (common/flatten.h): per mesh, the instance that places it.
+        const std::vector<int64_t> flat_instance =
+            config.flatten ? flattenable_meshes(scene) : std::vector<int64_t>(scene.meshes.size(), -1);
 
         // One Embree scene per instanced mesh (geometry ID 0 inside it); flattened meshes are
         // built in world space and attached to the top level below.
