@@ -27,10 +27,12 @@ bool kernel_offers_huge_pages() {
     return line.find("[always]") != std::string::npos || line.find("[madvise]") != std::string::npos;
 }
 
-/// GLIBC_TUNABLES already sets glibc.malloc.hugetlb (to any value: the caller's choice stands).
-bool tunable_given() {
+/// The value GLIBC_TUNABLES gives glibc.malloc.hugetlb, or nullptr when it gives none.
+const char* tunable_value() {
+    constexpr const char* kName = "glibc.malloc.hugetlb=";
     const char* t = std::getenv("GLIBC_TUNABLES");
-    return t != nullptr && std::strstr(t, "glibc.malloc.hugetlb=") != nullptr;
+    const char* at = t != nullptr ? std::strstr(t, kName) : nullptr;
+    return at != nullptr ? at + std::strlen(kName) : nullptr;
 }
 
 /// Runs that only print (--help, --version, no arguments) gain nothing from a second start.
@@ -65,9 +67,8 @@ bool under_valgrind() {
 
 bool huge_pages_requested() {
     if (g_restarted) return true;
-    const char* t = std::getenv("GLIBC_TUNABLES");
-    const char* at = t != nullptr ? std::strstr(t, "glibc.malloc.hugetlb=") : nullptr;
-    return at != nullptr && at[std::strlen("glibc.malloc.hugetlb=")] != '0';
+    const char* value = tunable_value();
+    return value != nullptr && *value != '0';
 }
 
 void restart_with_huge_pages(char** argv) {
@@ -81,7 +82,8 @@ void restart_with_huge_pages(char** argv) {
         else ::unsetenv("GLIBC_TUNABLES");
         return;
     }
-    if (tunable_given() || only_prints(argv) || only_small_scene_files(argv) || under_valgrind()) return;
+    // The caller's own setting of the tunable (any value) stands.
+    if (tunable_value() != nullptr || only_prints(argv) || only_small_scene_files(argv) || under_valgrind()) return;
     if (const char* opt = std::getenv("WHITTED_HUGE_PAGES"); opt != nullptr && std::strcmp(opt, "0") == 0) return;
     if (!kernel_offers_huge_pages()) return;
     const char* old = std::getenv("GLIBC_TUNABLES");

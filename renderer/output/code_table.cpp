@@ -55,8 +55,6 @@ std::optional<CodeTable> CodeTable::build(const Evaluate& f, int bits) {
     for (int c = 0; c < 3; ++c) {
         const auto& gk = grid_keys[size_t(c)];
         const auto& gc = grid_codes[size_t(c)];
-        auto& t = table.m_channels[c].thresholds;
-        t.assign(max_code, 0);
         lo[size_t(c)].assign(max_code, 0);
         hi[size_t(c)].assign(max_code, 0);
         size_t g = 0;

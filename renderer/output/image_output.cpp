@@ -77,8 +77,8 @@ struct DisplayTransform::Impl {
     std::string view;
     OCIO::ConstConfigRcPtr config;
     OCIO::ConstCPUProcessorRcPtr cpu;  ///< F32 RGB in, F32 RGB out; apply() is const and thread-safe
-    std::once_flag tables_built[2];       ///< 8 and 16 bits
-    std::optional<CodeTable> tables[2];
+    std::once_flag table_built;           ///< the 8-bit code table, built on first use
+    std::optional<CodeTable> table;
 };
 
 DisplayTransform::DisplayTransform(const ColorSettings& settings) : m_impl(std::make_unique<Impl>()) {
@@ -171,13 +171,13 @@ Color DisplayTransform::apply(Color c) const {
 }
 
 const CodeTable* DisplayTransform::code_table(int bits) const {
-    const int i = bits == 16 ? 1 : 0;
-    std::call_once(m_impl->tables_built[i], [&] {
-        if (bits == 16 || m_impl->cpu->hasChannelCrosstalk()) return;
-        m_impl->tables[i] = CodeTable::build([this](float* rgb, size_t n) { apply(rgb, n); }, bits);
-        log_debug("OCIO: {}-bit code table {}", bits, m_impl->tables[i] ? "in use" : "refused (codes from the transform)");
+    if (bits != 8) return nullptr;
+    std::call_once(m_impl->table_built, [&] {
+        if (m_impl->cpu->hasChannelCrosstalk()) return;
+        m_impl->table = CodeTable::build([this](float* rgb, size_t n) { apply(rgb, n); }, 8);
+        log_debug("OCIO: 8-bit code table {}", m_impl->table ? "in use" : "refused (codes from the transform)");
     });
-    return m_impl->tables[i] ? &*m_impl->tables[i] : nullptr;
+    return m_impl->table ? &*m_impl->table : nullptr;
 }
 
 const std::string& DisplayTransform::config_path() const { return m_impl->config_path; }
