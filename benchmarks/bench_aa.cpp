@@ -43,7 +43,7 @@ namespace {
 namespace fs = std::filesystem;
 
 /// Bumped whenever a renderer change invalidates cached references.
-constexpr const char* kReferenceVersion = "aa-reference-v3";  // v2: ray offsets in units of the hit primitive; v3: opaque covers (default.glb)
+constexpr const char* kReferenceVersion = "aa-reference-v4";  // v2: ray offsets in units of the hit primitive; v3: opaque covers (default.glb); v4: texture footprint = sample spacing
 
 struct BenchAaOptions {
     std::vector<std::string> scenes;

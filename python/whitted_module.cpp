@@ -160,7 +160,7 @@ void for_chunks(size_t n, int threads, F&& body) {
 /// The keyword arguments render() takes: the scene file's keys (docs/scene-format.md), so that a
 /// scene file's settings fill what the caller did not pass, as the CLI's flags do.
 const std::set<std::string>& render_keywords() {
-    static const std::set<std::string> k{"width", "height", "camera", "aa", "aa_threshold", "aa_depth", "spp", "filter",
+    static const std::set<std::string> k{"width", "height", "camera", "aa", "aa_threshold", "aa_depth", "spp", "filter", "texture_filter",
                                          "max_depth", "min_weight", "fresnel", "specialize", "refract_thin",
                                          "mirror_cutoff", "max_exponent", "exposure", "background", "ambient",
                                          "tile_size", "threads", "crop", "aov", "accel", "robust", "progress"};
@@ -191,6 +191,7 @@ RenderSettings render_settings(const PyScene& s, const py::kwargs& kw) {
         else if (key == "aa_depth") rs.aa.depth = v.cast<int>();
         else if (key == "spp") rs.aa.spp = v.cast<int>();
         else if (key == "filter") rs.aa.filter = parse_pixel_filter(v.cast<std::string>());
+        else if (key == "texture_filter") rs.aa.texture_filter = parse_texture_filter(v.cast<std::string>());
         else if (key == "max_depth") rs.integrator.max_depth = v.cast<int>();
         else if (key == "min_weight") rs.integrator.min_weight = v.cast<float>();
         else if (key == "fresnel") rs.integrator.fresnel = v.cast<bool>();
@@ -403,8 +404,8 @@ PYBIND11_MODULE(whitted, m) {
         },
         py::arg("scene"),
         "Renders the scene with the settings of `whitted render` (keyword arguments named as the scene file's "
-        "settings: width, height, camera, aa, aa_threshold, aa_depth, spp, filter, max_depth, min_weight, fresnel, "
-        "specialize, refract_thin, mirror_cutoff, max_exponent, exposure (stops), background, ambient, tile_size, "
+        "settings: width, height, camera, aa, aa_threshold, aa_depth, spp, filter, texture_filter, max_depth, min_weight, "
+        "fresnel, specialize, refract_thin, mirror_cutoff, max_exponent, exposure (stops), background, ambient, tile_size, "
         "threads, crop, aov, accel, robust, progress); the scene file's settings fill what is not given");
 
     m.def(

@@ -479,6 +479,11 @@ int main(int argc, char** argv) {
               "stratified: pixel filter, box or tent (radius 1 pixel)")
         ->check(CLI::IsMember({"box", "tent"}))->default_str(pixel_filter_name(rs.aa.filter));
     render->add_option_function<std::string>(
+              "--texture-filter", [&](const std::string& name) { rs.aa.texture_filter = parse_texture_filter(name); },
+              "Textures: mip (filtered over each sample's spacing: the pixel, pixel/k for stratified k*k, the "
+              "sub-square for adaptive) or none (point samples of the finest level: Whitted's model exactly)")
+        ->check(CLI::IsMember({"mip", "none"}))->default_str(texture_filter_name(rs.aa.texture_filter));
+    render->add_option_function<std::string>(
         "--crop", [&](const std::string& t) { if (!t.empty()) rs.crop = parse_crop(t); },
         "Render only the region x0,y0,x1,y1 (pixels, x1/y1 exclusive)");
     render->add_option("--threads", rs.threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 1024))

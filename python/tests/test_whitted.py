@@ -84,6 +84,16 @@ def test_every_aa_mode_and_the_scene_files_settings(tmp_path):
         whitted.render(s, aov=["colour"])
 
 
+def test_texture_filter_keyword(glb):
+    # default.glb's checkerboard: point samples (none) alias where MIP filtering averages.
+    mip = whitted.render(glb, width=48, aa="center", texture_filter="mip")
+    none = whitted.render(glb, width=48, aa="center", texture_filter="none")
+    assert not np.array_equal(mip.beauty, none.beauty)
+    assert np.array_equal(mip.beauty, whitted.render(glb, width=48, aa="center").beauty)  # mip is the default
+    with pytest.raises(whitted.Error, match="texture-filter"):
+        whitted.render(glb, width=8, texture_filter="bilinear")
+
+
 def test_display_is_what_render_writes_to_png(glb, tmp_path):
     img = whitted.render(glb, width=64, aa="center")
     for view in ("Standard", "ACES 1.0 SDR-video"):

@@ -35,6 +35,19 @@ const char* aa_mode_name(AaMode mode) {
 
 const char* pixel_filter_name(PixelFilter filter) { return filter == PixelFilter::Box ? "box" : "tent"; }
 
+TextureFilter parse_texture_filter(const std::string& name) {
+    if (name == "mip") return TextureFilter::Mip;
+    if (name == "none") return TextureFilter::None;
+    throw Error(fmt::format("--texture-filter: unknown filter '{}' (available: mip, none)", name));
+}
+
+const char* texture_filter_name(TextureFilter filter) { return filter == TextureFilter::Mip ? "mip" : "none"; }
+
+float adaptive_point_spacing(int i, int j, int depth) {
+    const unsigned n = 1u << depth;
+    return float(1u << std::countr_zero(unsigned(i) | unsigned(j) | n)) / float(n);
+}
+
 int stratified_side(int spp) {
     if (spp < 1) return 0;
     const int k = int(std::lround(std::sqrt(double(spp))));

@@ -24,6 +24,12 @@ namespace whitted {
 
 enum class AaMode : uint8_t { Center, Corners, Adaptive, Stratified };
 enum class PixelFilter : uint8_t { Box, Tent };
+/// How textures are filtered. `Mip`: trilinear MIP lookups over the footprint of the sample
+/// spacing (a ray cone per camera ray: the pixel for centre and corners, pixel/k for stratified
+/// k x k, the sub-square for adaptive points), so supersampling converges to the box-filtered
+/// integral of the point-sampled texture. `None`: every lookup point-samples the finest level, the
+/// environment included (Whitted's model exactly).
+enum class TextureFilter : uint8_t { Mip, None };
 
 struct AaSettings {
     AaMode mode = AaMode::Center;     ///< sampling mode; the library default is one ray per pixel centre (exact
@@ -33,6 +39,7 @@ struct AaSettings {
     int depth = 3;                    ///< adaptive: maximum subdivision depth (0..8); sub-squares of 1/2^depth pixel
     int spp = 16;                     ///< stratified: samples per pixel, a square number k*k (1..4096)
     PixelFilter filter = PixelFilter::Box;  ///< stratified: box (1 pixel) or tent (radius 1 pixel)
+    TextureFilter texture_filter = TextureFilter::Mip;  ///< texture footprints (docs/antialiasing.md)
 };
 
 /// Parses "center", "corners", "adaptive", "stratified"; throws whitted::Error otherwise.
@@ -41,6 +48,14 @@ AaMode parse_aa_mode(const std::string& name);
 PixelFilter parse_pixel_filter(const std::string& name);
 const char* aa_mode_name(AaMode mode);
 const char* pixel_filter_name(PixelFilter filter);
+/// Parses "mip", "none"; throws whitted::Error otherwise.
+TextureFilter parse_texture_filter(const std::string& name);
+const char* texture_filter_name(TextureFilter filter);
+/// Width of a sample's texture footprint as a fraction of the pixel: 1 for centre and corner
+/// samples, 1/k for stratified k x k, and for adaptive point (i, j) of a pixel's 2^depth grid the
+/// side of the sub-square whose split created it (a pure function of the point, so a point shared
+/// by two pixels or two levels has one footprint): 2^trailing_zeros(i | j | 2^depth) / 2^depth.
+float adaptive_point_spacing(int i, int j, int depth);
 /// Throws whitted::Error naming the flag when a setting is out of range (depth, spp not k*k).
 void validate_aa_settings(const AaSettings& aa);
 /// k for spp = k*k, or 0 when spp is not a positive square.

@@ -62,6 +62,7 @@ struct AdaptiveScratch {
     std::array<uint32_t, WhittedIntegrator::kCameraBatch> pending;  ///< grid indices of the points to trace
     std::array<Ray, WhittedIntegrator::kCameraBatch> pending_rays;  ///< their camera rays
     size_t pending_count = 0;
+    float pending_spacing = 1.f;       ///< their footprint (adaptive_point_spacing), the same for the batch
     std::vector<Color> right;          ///< n - 1 points inside the previous pixel's right edge
     std::vector<uint8_t> right_valid;
     std::vector<Color> bottom;         ///< per tile column, n - 1 points inside the bottom edge of the pixel above
@@ -77,7 +78,7 @@ public:
     Impl(const CameraModel& camera, const WhittedIntegrator& integrator, Film& film, const AaSettings& aa,
          float exposure)
         : m_camera(camera), m_integrator(integrator), m_film(film), m_aa(aa), m_exposure(exposure),
-          m_cone(camera.pixel_cone()), m_n(1 << aa.depth) {
+          m_cone(aa.texture_filter == TextureFilter::Mip ? camera.pixel_cone() : RayCone{}), m_n(1 << aa.depth) {
         if (aa.mode == AaMode::Corners || aa.mode == AaMode::Adaptive)
             m_lattice.assign(size_t(film.width() + 1) * size_t(film.height() + 1), Color(0.f));
     }
@@ -90,9 +91,12 @@ public:
         return Color(0.f);
     }
 
-    /// One primary sample at image position (x, y).
-    Color sample(double x, double y, RayCounters& rc, PrimaryInfo* info = nullptr) {
-        return exposed(m_integrator.trace(m_camera.generate(x, y), RayKind::Camera, 0, rc, info, m_cone));
+    /// The ray cone of a sample whose footprint is `spacing` pixels wide (zero with --texture-filter none).
+    RayCone cone(float spacing) const { return RayCone{m_cone.width * spacing, m_cone.spread * spacing}; }
+
+    /// One primary sample at image position (x, y), its texture footprint `spacing` pixels wide.
+    Color sample(double x, double y, float spacing, RayCounters& rc, PrimaryInfo* info = nullptr) {
+        return exposed(m_integrator.trace(m_camera.generate(x, y), RayKind::Camera, 0, rc, info, cone(spacing)));
     }
 
     /// Samples traced together by sample_row: a coherent row (the integrator's batch size).
@@ -100,10 +104,10 @@ public:
 
     /// Up to kRow camera rays traced as one batch (WhittedIntegrator::trace_camera: Embree packets
     /// in the specialised kernels): out[i] is what sample() gives for rays[i], the same arithmetic
-    /// in the same order. `info` may be null.
-    void trace_row(std::span<const Ray> rays, Color* out, RayCounters& rc, PrimaryInfo* info = nullptr) {
+    /// in the same order. `info` may be null; `spacing` as for sample().
+    void trace_row(std::span<const Ray> rays, float spacing, Color* out, RayCounters& rc, PrimaryInfo* info = nullptr) {
         const size_t n = rays.size();
-        m_integrator.trace_camera(rays, std::span<Color>(out, n), rc, m_cone,
+        m_integrator.trace_camera(rays, std::span<Color>(out, n), rc, cone(spacing),
                                   info ? std::span<PrimaryInfo>(info, n) : std::span<PrimaryInfo>{});
         for (size_t i = 0; i < n; ++i) out[i] = exposed(out[i]);
     }
@@ -114,7 +118,7 @@ public:
         UninitializedArray<Ray, kRow> rays;  // generate_row writes every ray
         const std::span<Ray> row = rays.first(size_t(n));
         m_camera.generate_row(x0, 1.0, y, row);
-        trace_row(row, out, rc, info);
+        trace_row(row, 1.f, out, rc, info);
     }
 
     /// center: one ray through each pixel centre (it also gives the AOVs), rows of a tile in batches.
@@ -135,6 +139,7 @@ public:
     void stratified_tile(const TileRect& r, RayCounters& rc) {
         const int k = stratified_side(m_aa.spp);
         const double inv_k = 1.0 / k;
+        const float spacing = float(inv_k);  // each sample's footprint: its stratum
         for (int y = r.y0; y < r.y1; ++y)
             for (int x = r.x0; x < r.x1; ++x) {
                 // Seeded by the full-image pixel index: crops and tiles see the same jitter.
@@ -158,7 +163,7 @@ public:
                         rays.at[i] = m_camera.generate(sx, sy);
                     }
                     UninitializedArray<Color, kRow> c;
-                    trace_row(rays.first(size_t(n)), c.at, rc);
+                    trace_row(rays.first(size_t(n)), spacing, c.at, rc);
                     for (int i = 0; i < n; ++i) sum += c.at[i];
                 }
                 finish_pixel(x, y, sum * float(1.0 / m_aa.spp), float(m_aa.spp), nullptr, rc);
@@ -280,6 +285,9 @@ private:
 
     /// Queues point (i, j) of pixel p for tracing in the next batch (flushed when full).
     void queue(const PixelRecursion& p, AdaptiveScratch& s, RayCounters& rc, int i, int j) {
+        const float spacing = adaptive_point_spacing(i, j, m_aa.depth);
+        if (s.pending_count > 0 && spacing != s.pending_spacing) flush(s, rc);  // one footprint per batch
+        s.pending_spacing = spacing;
         s.pending[s.pending_count] = uint32_t(j * (m_n + 1) + i);
         s.pending_rays[s.pending_count] = m_camera.generate(p.x + double(i) / m_n, p.y + double(j) / m_n);
         if (++s.pending_count == s.pending.size()) flush(s, rc);
@@ -290,7 +298,7 @@ private:
     void flush(AdaptiveScratch& s, RayCounters& rc) {
         if (s.pending_count == 0) return;
         UninitializedArray<Color, WhittedIntegrator::kCameraBatch> c;
-        trace_row(std::span<const Ray>(s.pending_rays.data(), s.pending_count), c.at, rc);
+        trace_row(std::span<const Ray>(s.pending_rays.data(), s.pending_count), s.pending_spacing, c.at, rc);
         for (size_t q = 0; q < s.pending_count; ++q) s.value[s.pending[q]] = c.at[q];
         s.pending_count = 0;
     }
@@ -334,7 +342,9 @@ private:
         if (in_tile || !in_window) return false;  // hand_over_edges() passes it on / nobody else needs it
         // A tile border: traced alone, inside EdgeSamples' lock, so a concurrent tile never traces it twice.
         const uint64_t gx = uint64_t(p.x) * uint64_t(n) + uint64_t(i), gy = uint64_t(p.y) * uint64_t(n) + uint64_t(j);
-        out = m_edges.get(gx << 32 | gy, [&] { return sample(p.x + double(i) / n, p.y + double(j) / n, rc); });
+        out = m_edges.get(gx << 32 | gy, [&] {
+            return sample(p.x + double(i) / n, p.y + double(j) / n, adaptive_point_spacing(i, j, m_aa.depth), rc);
+        });
         return true;
     }
 
@@ -427,7 +437,7 @@ private:
     Film& m_film;
     const AaSettings& m_aa;
     const float m_exposure;
-    const RayCone m_cone;
+    const RayCone m_cone;  ///< a pixel-wide footprint (zero: --texture-filter none)
     const int m_n;                       ///< adaptive grid steps per pixel side, 2^depth
     std::vector<Color> m_lattice;        ///< (w+1) x (h+1) pixel-corner samples of the window
     EdgeSamples m_edges;

@@ -130,6 +130,7 @@ SettingList describe_image_settings(const RenderSettings& rs) {
         {"aa_depth", std::to_string(rs.aa.depth)},
         {"spp", std::to_string(rs.aa.spp)},
         {"filter", pixel_filter_name(rs.aa.filter)},
+        {"texture_filter", texture_filter_name(rs.aa.texture_filter)},
         {"accel", rs.accel},
         {"robust", flag(rs.robust)},
     };

@@ -38,7 +38,16 @@ Scene busy_scene() {
     Scene s;
     WhittedCoeffs floor;
     floor.kd = floor.ka = Color(0.6f, 0.55f, 0.5f);
-    add_mesh(s, make_quad({-10, -10, 0}, {10, -10, 0}, {10, 10, 0}, {-10, 10, 0}, add_classic_material(s, floor)));
+    const uint32_t floor_material = add_classic_material(s, floor);
+    // Whitted's checkerboard in world space: its filtered value depends on each sample's footprint.
+    Texture checker;
+    checker.name = "checker";
+    checker.kind = TextureKind::Checker;
+    checker.checker.size = 0.7f;
+    checker.checker.world_space = true;
+    s.textures.push_back(checker);
+    s.materials[floor_material].classic_color_texture.texture = 0;
+    add_mesh(s, make_quad({-10, -10, 0}, {10, -10, 0}, {10, 10, 0}, {-10, 10, 0}, floor_material));
     WhittedCoeffs mirror;
     mirror.kr = Color(0.8f);
     mirror.kd = mirror.ka = Color(0.1f);
@@ -153,15 +162,41 @@ struct PerRayRadiance {
     PerRayRadiance(const Scene& s, const RenderSettings& rs, int w, int h)
         : view(s, rs.mapping), accel(create_accelerator("embree", s, view, AccelConfig{rs.robust, 0})),
           integrator(view, *accel, rs.integrator), camera(s.cameras[0], w, h) {}
-    Color operator()(double x, double y) const {
+    /// `spacing`: the sample's texture footprint in pixels (the ray cone's scale).
+    Color operator()(double x, double y, float spacing = 1.f) const {
         RayCounters rc;
-        return integrator.trace(camera.generate(x, y), RayKind::Camera, 0, rc, nullptr, camera.pixel_cone());
+        const RayCone pixel = camera.pixel_cone();
+        return integrator.trace(camera.generate(x, y), RayKind::Camera, 0, rc, nullptr,
+                                RayCone{pixel.width * spacing, pixel.spread * spacing});
     }
     SceneView view;
     std::unique_ptr<Accelerator> accel;
     WhittedIntegrator integrator;
     CameraModel camera;
 };
+
+/// The texture footprint of point (X, Y) of a 1/n-pixel lattice (n a power of 2), as the test
+/// derives it: the side of the largest sub-square of the pixel recursion (at most the pixel) that
+/// has the point as a corner, in pixels.
+float lattice_point_spacing(int64_t X, int64_t Y, int n) {
+    int64_t g = n;
+    while (X % g != 0 || Y % g != 0) g /= 2;
+    return float(g) / float(n);
+}
+
+TEST(AaSampling, AdaptivePointSpacingIsTheSubSquareThatCreatedThePoint) {
+    EXPECT_EQ(adaptive_point_spacing(0, 0, 3), 1.f);      // pixel corners
+    EXPECT_EQ(adaptive_point_spacing(8, 0, 3), 1.f);
+    EXPECT_EQ(adaptive_point_spacing(4, 0, 3), 0.5f);     // first split: edge midpoints and centre
+    EXPECT_EQ(adaptive_point_spacing(4, 4, 3), 0.5f);
+    EXPECT_EQ(adaptive_point_spacing(2, 4, 3), 0.25f);
+    EXPECT_EQ(adaptive_point_spacing(8, 6, 3), 0.25f);
+    EXPECT_EQ(adaptive_point_spacing(1, 0, 3), 0.125f);
+    EXPECT_EQ(adaptive_point_spacing(7, 8, 3), 0.125f);
+    EXPECT_EQ(adaptive_point_spacing(0, 0, 0), 1.f);
+    for (int i = 0; i <= 32; ++i)
+        for (int j = 0; j <= 32; ++j) EXPECT_EQ(adaptive_point_spacing(i, j, 5), lattice_point_spacing(i, j, 32));
+}
 
 TEST(AaSampling, AlwaysSplitEqualsAnIndependentUniformSubdivision) {
     const Scene s = busy_scene();
@@ -196,7 +231,10 @@ TEST(AaSampling, AlwaysSplitEqualsAnIndependentUniformSubdivision) {
                 for (int j = 0; j < n; ++j)
                     for (int i = 0; i < n; ++i) {
                         const double x0 = x + double(i) / n, y0 = y + double(j) / n, x1 = x0 + 1.0 / n, y1 = y0 + 1.0 / n;
-                        sum += (radiance(x0, y0) + radiance(x1, y0) + radiance(x0, y1) + radiance(x1, y1)) * 0.25f;
+                        auto at = [&](int di, int dj, double px, double py) {
+                            return radiance(px, py, lattice_point_spacing(int64_t(x) * n + i + di, int64_t(y) * n + j + dj, n));
+                        };
+                        sum += (at(0, 0, x0, y0) + at(1, 0, x1, y0) + at(0, 1, x0, y1) + at(1, 1, x1, y1)) * 0.25f;
                     }
                 const Color want = sum * (1.f / float(n * n));
                 const Color got = film.beauty[film.index(x, y)];
@@ -229,7 +267,8 @@ TEST(AaSampling, AdaptiveEqualsAnIndependentDepthFirstRecursion) {
                 int k = 0;
                 for (auto [dx, dy] : {std::pair{0, 0}, std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}}) {
                     points.insert({x0 + dx * size, y0 + dy * size});
-                    c[k++] = radiance(double(x0 + dx * size) / n, double(y0 + dy * size) / n);
+                    c[k++] = radiance(double(x0 + dx * size) / n, double(y0 + dy * size) / n,
+                                      lattice_point_spacing(x0 + dx * size, y0 + dy * size, n));
                 }
                 if (level < depth && aa_contrast(c[0], c[1], c[2], c[3]) > threshold) {
                     if (level == 0) ++split_pixels;

@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
 
 #include "renderer/integrator/render.h"
 #include "renderer/scene/scene_builder.h"
@@ -11,9 +14,9 @@
 namespace whitted {
 namespace {
 
-/// An unlit quad [-8, 8]^2 with a 256 x 256 one-texel checkerboard (black / white, linear data),
-/// seen by an orthographic camera of `size` pixels over the quad.
-Scene checker_scene() {
+/// An unlit quad [-8, 8]^2 with a 256 x 256 checkerboard of `check` x `check` texel squares
+/// (black / white, linear data), seen by an orthographic camera over the quad.
+Scene checker_scene(int check = 1) {
     Scene s;
     Texture t;
     t.name = "checker";
@@ -22,7 +25,7 @@ Scene checker_scene() {
     base.texels.resize(256 * 256 * 4);
     for (int y = 0; y < 256; ++y)
         for (int x = 0; x < 256; ++x) {
-            const uint8_t v = ((x + y) & 1) ? 255 : 0;
+            const uint8_t v = ((x / check + y / check) & 1) ? 255 : 0;
             uint8_t* p = &base.texels[size_t(y * 256 + x) * 4];
             p[0] = p[1] = p[2] = v;
             p[3] = 255;
@@ -76,6 +79,70 @@ TEST(AaTextureLod, MagnifiedCheckerboardKeepsItsChecks) {
     const auto [lo, hi] = pixel_range(film);
     EXPECT_NEAR(lo, 0.21875f, 1e-4f);
     EXPECT_NEAR(hi, 0.78125f, 1e-4f);
+}
+
+TEST(AaTextureLod, TextureFilterNonePointSamplesTheFinestLevel) {
+    const Scene s = checker_scene();
+    for (AaMode mode : {AaMode::Center, AaMode::Stratified}) {
+        RenderSettings rs;
+        rs.width = rs.height = 15;  // about 17 texels per pixel, centres at every phase of a check
+        rs.aa.mode = mode;
+        rs.aa.spp = 1;  // stratified: one jittered point per pixel
+        rs.aa.texture_filter = TextureFilter::None;
+        const auto [lo, hi] = pixel_range(Renderer(s, rs).render());
+        // Point samples of a one-texel checkerboard alias: pixels far from the average of 0.5.
+        EXPECT_LT(lo, 0.25f) << aa_mode_name(mode);
+        EXPECT_GT(hi, 0.75f) << aa_mode_name(mode);
+        rs.aa.texture_filter = TextureFilter::Mip;
+        const auto [mip_lo, mip_hi] = pixel_range(Renderer(s, rs).render());
+        EXPECT_NEAR(mip_lo, 0.5f, 0.03f) << aa_mode_name(mode);
+        EXPECT_NEAR(mip_hi, 0.5f, 0.03f) << aa_mode_name(mode);
+    }
+}
+
+double rmse(const Film& a, const Film& b) {
+    double sum = 0.0;
+    for (size_t i = 0; i < a.beauty.size(); ++i) {
+        const double d = double(a.beauty[i].x) - double(b.beauty[i].x);
+        sum += d * d;
+    }
+    return std::sqrt(sum / double(a.beauty.size()));
+}
+
+// Requirement of issue 25: the texture footprint follows the sample spacing, so stratified N spp
+// with MIP filtering converges to the box-filtered pixel integral of the point-sampled texture
+// (here 32 x 32 point samples per pixel). With a pixel-wide footprint for every sample the error
+// would stop falling at the blur of a second pixel-wide box: checks of about a pixel make that
+// blur large.
+TEST(AaTextureLod, StratifiedMipConvergesToThePointSampledPixelIntegral) {
+    const Scene s = checker_scene(4);
+    RenderSettings rs;
+    rs.width = rs.height = 72;  // 3.6 texels per pixel (MIP level 1.8 for a pixel footprint), checks of 1.1 pixels
+    rs.aa.mode = AaMode::Stratified;
+    rs.aa.spp = 1024;
+    rs.aa.texture_filter = TextureFilter::None;
+    const Film reference = Renderer(s, rs).render();
+    rs.aa.texture_filter = TextureFilter::Mip;
+    std::vector<double> error;
+    for (int spp : {4, 16, 64, 256}) {
+        rs.aa.spp = spp;
+        error.push_back(rmse(Renderer(s, rs).render(), reference));
+        std::printf("stratified %3d spp, mip: RMSE %.5f against 1024 point samples per pixel\n", spp, error.back());
+    }
+    for (size_t i = 1; i < error.size(); ++i) EXPECT_LT(error[i], 0.7 * error[i - 1]) << "step " << i;
+    EXPECT_LT(error.back(), 0.2 * error.front());
+    // Adaptive always-split: the leaves' points get their sub-square's footprint, so a deeper
+    // uniform subdivision comes closer as well.
+    rs.aa.mode = AaMode::Adaptive;
+    rs.aa.threshold = -1.f;
+    double previous = 1e9;
+    for (int depth : {1, 2, 3}) {
+        rs.aa.depth = depth;
+        const double e = rmse(Renderer(s, rs).render(), reference);
+        std::printf("adaptive always-split depth %d, mip: RMSE %.5f\n", depth, e);
+        EXPECT_LT(e, 0.8 * previous) << "depth " << depth;
+        previous = e;
+    }
 }
 
 }  // namespace
