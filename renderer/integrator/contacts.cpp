@@ -178,9 +178,10 @@ std::shared_ptr<const DielectricContacts> DielectricContacts::find(const SceneVi
 std::shared_ptr<const OpaqueCovers> OpaqueCovers::find(const SceneView& view) {
     const Scene& scene = view.scene();
     const SceneAnalysis& analysis = view.analysis();
+    // Thin sheets and solid dielectrics alike: a glass slab lying on a table has its bottom face in
+    // the table's plane, and the refracted ray must see the table, not exit into it.
     const std::vector<ContactObject> covered = contact_objects(scene, [&](uint32_t material) {
-        const MaterialFeatures& mf = analysis.materials[material];
-        return mf.transmission && mf.constant.thin;
+        return analysis.materials[material].transmission;
     });
     if (covered.empty()) return nullptr;
     const std::vector<ContactObject> opaque = contact_objects(scene, [&](uint32_t material) {

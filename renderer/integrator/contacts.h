@@ -1,8 +1,8 @@
 // Coincident faces the closest-hit query cannot tell apart: where two non-thin dielectrics touch
-// (DielectricContacts) and where an opaque surface lies under a thin transmissive one
+// (DielectricContacts) and where an opaque surface lies under a transmissive one
 // (OpaqueCovers). Both are small in-house BVHs over just the objects concerned, built only for
 // scenes that have such pairs and probed along the normal of a hit (docs/numerical-stability.md,
-// "Touching dielectrics" and "Opaque surfaces under thin transmissive ones").
+// "Touching dielectrics" and "Opaque surfaces under transparent ones").
 #pragma once
 
 #include <cstdint>
@@ -76,12 +76,13 @@ public:
     uint32_t mesh_flags(uint32_t) const override { return kNeedsAccept; }
 };
 
-/// A thin transmissive object resting on an opaque one (a glass box on a floor) has a face in the
-/// floor's plane, and the accelerator reports either as rounding decides. The rule that does not
-/// depend on the tie: the opaque surface covers the transparent face lying on it.
+/// A transmissive object resting on an opaque one (a thin glass box or a solid glass slab on a
+/// floor) has a face in the floor's plane, and the accelerator reports either as rounding decides.
+/// The rule that does not depend on the tie: the opaque surface covers the transparent face lying
+/// on it.
 class OpaqueCovers final : public ContactSearch {
 public:
-    /// Null when no thin transmissive object can touch an opaque one.
+    /// Null when no transmissive object can touch an opaque one.
     static std::shared_ptr<const OpaqueCovers> find(const SceneView& view);
 
     /// The opaque surface within guaranteed_gap(p, scale) of p on either side of the surface hit

@@ -47,7 +47,7 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
     const MaterialFeatures& mf = features(hit);
     const SurfacePoint sp = surface_point<K>(ray, hit, mf, cone);
     if constexpr (K.transmission) {
-        // An opaque surface lying under a thin transmissive one is what the ray sees.
+        // An opaque surface under a transmissive one lying on it is what the ray sees.
         if (const std::optional<Hit> cover = covering_surface(hit, sp, counters))
             return shade<K>(ray, *cover, depth, counters, primary, cone, weight);
     }

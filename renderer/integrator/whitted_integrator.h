@@ -162,7 +162,7 @@ private:
     TraceFn m_trace = nullptr;          ///< trace<m_kernel>
     CameraFn m_trace_camera = nullptr;  ///< trace_camera<m_kernel>
     std::shared_ptr<const DielectricContacts> m_contacts;  ///< null when no dielectrics touch
-    std::shared_ptr<const OpaqueCovers> m_covers;          ///< null when no thin transmissive object
+    std::shared_ptr<const OpaqueCovers> m_covers;          ///< null when no transmissive object
                                                            ///< can touch an opaque one
 };
 
