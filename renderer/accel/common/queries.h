@@ -1,8 +1,8 @@
 // The two ray queries as objects the in-house traversals report candidate hits to. They hold the
 // SurfaceFilter semantics every backend must share with Embree (accelerator.h), so that a backend
 // only has to find candidate triangles:
-//   - ClosestQuery keeps the nearest accepted hit; accept() is asked only for meshes whose
-//     mesh_flags() has kNeedsAccept.
+//   - ClosestQuery keeps the nearest accepted hit (exact ties: tie_precedes()); accept() is asked
+//     only for meshes whose mesh_flags() has kNeedsAccept.
 //   - ShadowQuery stops at the first crossing of a mesh without kNeedsTransmittance (opaque to
 //     shadow rays; kNeedsAccept plays no part in shadow queries, accelerator.h), otherwise
 //     collects the crossings; resolve() sorts them by t, removes duplicates per (geom, inst,
@@ -60,6 +60,15 @@ struct InstanceContext {
     uint32_t flags = 0;  ///< SurfaceFilter::mesh_flags(geom)
 };
 
+/// The tie rule of every in-house closest-hit query: of two accepted hits at exactly the same t,
+/// the one with the smaller (instance, geometry, primitive) wins, so the answer does not depend on
+/// the order a traversal (single ray, batch, BVH child order, grid cell walk) meets them in.
+inline bool tie_precedes(const Hit& a, const Hit& b) {
+    if (a.inst != b.inst) return a.inst < b.inst;
+    if (a.geom != b.geom) return a.geom < b.geom;
+    return a.prim < b.prim;
+}
+
 /// Closest-hit query. T is the precision the backend computes t in.
 template <typename T>
 struct ClosestQuery {
@@ -73,7 +82,8 @@ struct ClosestQuery {
 
     ClosestQuery(const SurfaceFilter& f, const Ray& r, RayKind k) : filter(f), ray(r), kind(k), tmax(T(r.tfar)) {}
 
-    /// A hit with tnear < t <= tmax. Returns true to end the whole traversal (never).
+    /// A hit with tnear < t <= tmax. Returns true to end the whole traversal (never). At t equal
+    /// to the best hit's, tie_precedes() decides.
     bool report(T t, T u, T v, uint32_t prim, uint8_t /*part*/ = 0) {
         Hit h;
         h.t = float(t);
@@ -82,6 +92,7 @@ struct ClosestQuery {
         h.prim = prim;
         h.geom = ctx.geom;
         h.inst = ctx.inst;
+        if (t == tmax && best.valid() && !tie_precedes(h, best)) [[unlikely]] return false;
         if ((ctx.flags & SurfaceFilter::kNeedsAccept) && !filter.accept(ray, h, kind)) return false;
         best = h;
         tmax = t;
