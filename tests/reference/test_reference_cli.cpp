@@ -18,20 +18,7 @@ namespace {
 using namespace whitted::test;
 
 /// Runs whitted-reference with `args` (shell-quoted by the caller).
-Result run_reference(const std::string& args) {
-    const std::filesystem::path dir = scratch_dir("whitted_reference_cli", "log");
-    static int counter = 0;
-    const std::filesystem::path out = dir / ("out" + std::to_string(counter) + ".txt");
-    const std::filesystem::path err = dir / ("err" + std::to_string(counter++) + ".txt");
-    const std::string cmd = std::string("'") + WHITTED_REFERENCE_EXE + "' " + args + " >" + quoted(out) + " 2>" +
-                            quoted(err) + " </dev/null";
-    const int status = std::system(cmd.c_str());
-    Result r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-}
+Result run_reference(const std::string& args) { return run_program(WHITTED_REFERENCE_EXE, args); }
 
 TEST(ReferenceCli, AgreesWithWhittedRenderOnTheDefaultScene) {
     const std::filesystem::path dir = scratch_dir("whitted_reference_cli", "default");

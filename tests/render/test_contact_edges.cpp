@@ -37,15 +37,38 @@ Vec3d place(const Vec3d& p) {
     return {m(0, 0) * p.x + m(0, 2) * p.z + m(0, 3), p.y, m(2, 0) * p.x + m(2, 2) * p.z + m(2, 3)};
 }
 
+/// Scene `s` (its first material the floor's) gets the opaque floor y = 0, `object` standing on it
+/// in placement()'s frame (without its bottom face when `bottom` is false; make_box's last face is
+/// -y), two point lights and a camera at `eye` (box frame) looking at the origin. `object_first`
+/// puts the object before the floor (geometry order is one of the things ties are broken by).
+Scene on_floor(Scene s, Mesh object, bool bottom, bool object_first, const Vec3d& eye_in_frame) {
+    if (!bottom) object.indices.resize(object.indices.size() - 6);
+    auto add_floor = [&] { add_mesh(s, make_quad({-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-2, 0, -2}, 0)); };
+    if (!object_first) add_floor();
+    add_mesh(s, std::move(object), placement());
+    if (object_first) add_floor();
+    s.lights.push_back(point_light(place({0.3, 1.2, 0.4}), 2.f));
+    s.lights.push_back(point_light(place({-0.5, 0.8, -0.6}), 1.f));
+    const Vec3d eye = place(eye_in_frame);
+    s.cameras.push_back(make_camera(CameraType::Perspective, eye, place({0.0, 0.0, 0.0}) - eye, {0, 1, 0}, 0.6));
+    return s;
+}
+
+/// A scene whose material 0 is the floor's.
+Scene with_floor_material() {
+    Scene s;
+    WhittedCoeffs floor_c;
+    floor_c.kd = floor_c.ka = Color(0.8f, 0.75f, 0.7f);
+    add_classic_material(s, floor_c, "floor");
+    return s;
+}
+
 /// Opaque floor y = 0 and a thin red transmissive box [-0.1, 0.1] x [0, 0.26] x [-0.002, 0.002]
 /// (default.glb's panel: glTF transmission 1, single-sided, no volume) standing on it; without
 /// `bottom` the box has no bottom face. `box_first` puts the box before the floor in the scene
 /// (geometry order is one of the things ties are broken by).
 Scene panel_scene(bool bottom, bool box_first) {
-    Scene s;
-    WhittedCoeffs floor_c;
-    floor_c.kd = floor_c.ka = Color(0.8f, 0.75f, 0.7f);
-    const uint32_t floor_mat = add_classic_material(s, floor_c, "floor");
+    Scene s = with_floor_material();
     Material filter;
     filter.name = "red_filter";
     filter.model = MaterialModel::GltfPbr;
@@ -57,17 +80,8 @@ Scene panel_scene(bool bottom, bool box_first) {
     s.materials.push_back(filter);
     const uint32_t filter_mat = uint32_t(s.materials.size() - 1);
 
-    Mesh box = make_box({-0.1f, 0.f, -0.002f}, {0.1f, 0.26f, 0.002f}, filter_mat);
-    if (!bottom) box.indices.resize(box.indices.size() - 6);  // make_box's last face is -y
-    auto add_floor = [&] { add_mesh(s, make_quad({-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-2, 0, -2}, floor_mat)); };
-    if (!box_first) add_floor();
-    add_mesh(s, box, placement());
-    if (box_first) add_floor();
-    s.lights.push_back(point_light(place({0.3, 1.2, 0.4}), 2.f));
-    s.lights.push_back(point_light(place({-0.5, 0.8, -0.6}), 1.f));
-    const Vec3d eye = place({0.0, 0.46, 0.9});
-    s.cameras.push_back(make_camera(CameraType::Perspective, eye, place({0.0, 0.0, 0.0}) - eye, {0, 1, 0}, 0.6));
-    return s;
+    return on_floor(std::move(s), make_box({-0.1f, 0.f, -0.002f}, {0.1f, 0.26f, 0.002f}, filter_mat), bottom,
+                    box_first, {0.0, 0.46, 0.9});
 }
 
 struct Outcome {
@@ -138,10 +152,7 @@ TEST_P(ContactEdges, FloorUnderTransparentBoxIsNotLost) {
 /// A solid glass slab (a non-thin dielectric, ior 1.5) lying on the floor of panel_scene's frame:
 /// [-0.12, 0.12] x [0, 0.05] x [-0.09, 0.09], without its bottom face when `bottom` is false.
 Scene slab_scene(bool bottom, bool slab_first) {
-    Scene s;
-    WhittedCoeffs floor_c;
-    floor_c.kd = floor_c.ka = Color(0.8f, 0.75f, 0.7f);
-    const uint32_t floor_mat = add_classic_material(s, floor_c, "floor");
+    Scene s = with_floor_material();
     WhittedCoeffs glass;
     glass.kd = Color(0.02f);
     glass.ks = Color(0.5f);
@@ -151,18 +162,8 @@ Scene slab_scene(bool bottom, bool slab_first) {
     glass.ior = 1.5f;
     glass.thin = false;
     const uint32_t glass_mat = add_classic_material(s, glass, "glass");
-    Mesh slab = make_box({-0.12f, 0.f, -0.09f}, {0.12f, 0.05f, 0.09f}, glass_mat);
-    slab.name = "box";
-    if (!bottom) slab.indices.resize(slab.indices.size() - 6);  // make_box's last face is -y
-    auto add_floor = [&] { add_mesh(s, make_quad({-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-2, 0, -2}, floor_mat)); };
-    if (!slab_first) add_floor();
-    add_mesh(s, slab, placement());
-    if (slab_first) add_floor();
-    s.lights.push_back(point_light(place({0.3, 1.2, 0.4}), 2.f));
-    s.lights.push_back(point_light(place({-0.5, 0.8, -0.6}), 1.f));
-    const Vec3d eye = place({0.05, 0.42, 0.6});
-    s.cameras.push_back(make_camera(CameraType::Perspective, eye, place({0.0, 0.0, 0.0}) - eye, {0, 1, 0}, 0.6));
-    return s;
+    return on_floor(std::move(s), make_box({-0.12f, 0.f, -0.09f}, {0.12f, 0.05f, 0.09f}, glass_mat), bottom,
+                    slab_first, {0.05, 0.42, 0.6});
 }
 
 class DielectricOnFloor : public ::testing::TestWithParam<const char*> {};

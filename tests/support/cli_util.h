@@ -29,15 +29,15 @@ inline std::string slurp(const std::filesystem::path& p) {
     return ss.str();
 }
 
-/// Runs the whitted executable with `args` (shell-quoted by the caller), stdin from /dev/null;
-/// stdout and stderr go through files in a per-process scratch folder.
-inline Result run(const std::string& args) {
+/// Runs `exe` with `args` (shell-quoted by the caller), stdin from /dev/null; stdout and stderr go
+/// through files in a per-process scratch folder.
+inline Result run_program(const std::string& exe, const std::string& args) {
     static int counter = 0;
     const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("whitted_cli_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     const std::filesystem::path out = dir / ("out" + std::to_string(counter) + ".txt");
     const std::filesystem::path err = dir / ("err" + std::to_string(counter++) + ".txt");
-    const std::string cmd = std::string("'") + WHITTED_EXE + "' " + args + " >'" + out.string() + "' 2>'" +
+    const std::string cmd = std::string("'") + exe + "' " + args + " >'" + out.string() + "' 2>'" +
                             err.string() + "' </dev/null";
     const int status = std::system(cmd.c_str());
     Result r;
@@ -46,6 +46,11 @@ inline Result run(const std::string& args) {
     r.err = slurp(err);
     return r;
 }
+
+#ifdef WHITTED_EXE
+/// Runs the whitted executable with `args` (run_program).
+inline Result run(const std::string& args) { return run_program(WHITTED_EXE, args); }
+#endif
 
 /// A folder for one test's files, created if needed: <tmp>/<prefix>_<pid>/<name> (per process, so
 /// parallel ctest runs do not share it).
