@@ -74,6 +74,13 @@ struct SeenCrossing {
     uint8_t part;  ///< which root of a sphere (0 for triangles)
 };
 
+/// The closest hit so far of one lane of a camera-ray query (tie rule; no default initialisers, so
+/// a QueryContext costs nothing more for the other queries).
+struct TieRecord {
+    float t;
+    uint32_t inst, geom, prim;
+};
+
 /// RTCIntersectContext extended with what our filter functions need (Embree passes the context
 /// pointer through; it must be the first member).
 struct QueryContext {
@@ -85,6 +92,10 @@ struct QueryContext {
     /// even where it reorders the rays of a packet.
     const Ray* rays = nullptr;
     RayKind kind = RayKind::Camera;
+    /// Camera rays: per lane (RTCRay id), the hit accepted so far, for the tie rule
+    /// (camera_tie_filter); set by context() for camera queries only (t = inf: none yet), left
+    /// uninitialised for the others (no cost to shadow rays).
+    TieRecord best[16];
     Color transmittance{1.f};
     int seen_count = 0;
     SeenCrossing seen[kMaxSeen];
@@ -110,6 +121,35 @@ void intersect_filter(const RTCFilterFunctionNArguments* args) {
         if (args->valid[i] != -1) continue;
         const Hit h = hit_from_filter_args(args, i, q);
         if (!q.filter->accept(q.rays[RTCRayN_id(args->ray, args->N, i)], h, q.kind)) args->valid[i] = 0;
+    }
+}
+
+/// The tie rule of every closest-hit query (tie_precedes, queries.h): a candidate at exactly the t
+/// of the lane's best hit wins only with smaller (instance, geometry, primitive) ids.
+bool loses_tie(const Hit& h, const TieRecord& best) {
+    if (h.t != best.t) return false;
+    Hit b;
+    b.inst = best.inst;
+    b.geom = best.geom;
+    b.prim = best.prim;
+    return !tie_precedes(h, b);
+}
+
+void record(TieRecord& best, const Hit& h) { best = {h.t, h.inst, h.geom, h.prim}; }
+
+/// Context filter of camera-ray queries (after the geometry's own filter): the tie rule. Embree
+/// offers every candidate with t <= tfar, and which of two at the same t it meets last differs
+/// between its packet and single-ray traversals; camera rays are the only rays the kernels trace
+/// both ways (the specialised ones in packets, the general one ray by ray), so with the rule the
+/// kernels' images agree bit for bit. Secondary rays, always single, need no callback.
+void camera_tie_filter(const RTCFilterFunctionNArguments* args) {
+    auto& q = *reinterpret_cast<QueryContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        const Hit h = hit_from_filter_args(args, i, q);
+        TieRecord& best = q.best[RTCRayN_id(args->ray, args->N, i)];
+        if (loses_tie(h, best)) args->valid[i] = 0;
+        else record(best, h);
     }
 }
 
@@ -185,7 +225,7 @@ bool packet_sphere_roots(RTCRayN* ray, unsigned n, unsigned i, const SpherePrims
 /// Closest hit: the nearer root in (tnear, tfar] that accept() takes, else the farther one.
 void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
     const auto& spheres = *static_cast<const SpherePrims<float>*>(args->geometryUserPtr);
-    const auto& q = *reinterpret_cast<const QueryContext*>(args->context);
+    auto& q = *reinterpret_cast<QueryContext*>(args->context);
     const SpherePrims<float>::Item& s = spheres.item(args->primID);
     RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, args->N);
     RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, args->N);
@@ -195,11 +235,15 @@ void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
         if (!packet_sphere_roots(ray, args->N, i, s, roots[0], roots[1])) continue;
         const float tnear = RTCRayN_tnear(ray, args->N, i);
         float& tfar = RTCRayN_tfar(ray, args->N, i);
+        const unsigned lane = RTCRayN_id(ray, args->N, i);
         for (const float t : roots) {
             if (!(t > tnear && t <= tfar)) continue;
-            if ((s.flags & SurfaceFilter::kNeedsAccept) &&
-                !q.filter->accept(q.rays[RTCRayN_id(ray, args->N, i)], sphere_hit(s, t), q.kind))
-                continue;
+            const Hit h = sphere_hit(s, t);
+            if ((s.flags & SurfaceFilter::kNeedsAccept) && !q.filter->accept(q.rays[lane], h, q.kind)) continue;
+            if (q.kind == RayKind::Camera) {  // camera_tie_filter's rule (no filter runs for user geometry)
+                if (loses_tie(h, q.best[lane])) continue;
+                record(q.best[lane], h);
+            }
             tfar = t;
             RTCHitN_u(hit, args->N, i) = 0.f;
             RTCHitN_v(hit, args->N, i) = 0.f;
@@ -269,8 +313,10 @@ public:
         rtcSetDeviceErrorFunction(m_device, &EmbreeAccelerator::on_error, this);
         rtcSetDeviceMemoryMonitorFunction(m_device, &memory_monitor, &m_device_bytes);
 
+        // Context filters (camera_tie_filter) must be enabled in every scene, instanced ones too.
         const RTCSceneFlags flags = RTCSceneFlags((config.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE) |
-                                                  (config.compact ? RTC_SCENE_FLAG_COMPACT : RTC_SCENE_FLAG_NONE));
+                                                  (config.compact ? RTC_SCENE_FLAG_COMPACT : RTC_SCENE_FLAG_NONE) |
+                                                  RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
 
         // Which meshes are flattened (common/flatten.h): per mesh, the instance that places it.
         const std::vector<int64_t> flat_instance =
@@ -445,6 +491,10 @@ private:
         q.mesh_of_instance = &m_mesh_of_instance;
         q.rays = rays;
         q.kind = kind;
+        if (kind == RayKind::Camera) {
+            q.rtc.filter = &camera_tie_filter;
+            for (TieRecord& b : q.best) b.t = kInfinity;
+        }
         return q;
     }
 
