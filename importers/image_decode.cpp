@@ -105,6 +105,48 @@ std::string check_png_chunks(const uint8_t* p, size_t n) {
 
 bool is_png(const uint8_t* p, size_t n) { return n >= 8 && std::memcmp(p, "\x89PNG\r\n\x1a\n", 8) == 0; }
 
+bool is_jpeg(const uint8_t* p, size_t n) { return n >= 2 && p[0] == 0xFF && p[1] == 0xD8; }
+
+/// JPEG Huffman tables (DHT segments, ITU T.81 B.2.4.2) checked before stb_image sees them: a
+/// table holds at most 256 codes, and stb_image 2.27 writes one entry per declared code into a
+/// 257-entry array before checking the sum, out of bounds when the 16 counts add up to more
+/// (tests/data/fuzz-regressions/image/ubsan-stbi-huffman-more-than-256-codes.jpg). Walks every
+/// marker segment, the entropy-coded data after each SOS included (progressive files define tables
+/// between scans); a file cut short is left to the decoder. Returns the reason for refusing, or an
+/// empty string.
+std::string check_jpeg_tables(const uint8_t* p, size_t n) {
+    auto be16 = [&](size_t i) { return (size_t(p[i]) << 8) | p[i + 1]; };
+    size_t i = 2;  // after SOI
+    while (i + 4 <= n) {
+        if (p[i] != 0xFF) return {};  // not at a marker: the decoder reports it
+        const uint8_t marker = p[i + 1];
+        if (marker == 0xFF) {  // fill byte
+            ++i;
+            continue;
+        }
+        if (marker == 0xD9) return {};  // EOI
+        if (marker == 0xD8 || marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {
+            i += 2;
+            continue;
+        }
+        const size_t length = be16(i + 2), end = std::min(n, i + 2 + length);
+        if (marker == 0xC4) {
+            for (size_t t = i + 4; t + 17 <= end;) {
+                size_t codes = 0;
+                for (size_t k = 1; k <= 16; ++k) codes += p[t + k];
+                if (codes > 256)
+                    return fmt::format("corrupt JPEG: Huffman table at byte {} declares {} codes (at most 256)", t, codes);
+                t += 17 + codes;
+            }
+        }
+        i += 2 + length;
+        if (marker == 0xDA) {  // SOS: entropy-coded data up to the next marker (FF 00 is a stuffed FF, FF D0..D7 a restart)
+            while (i + 1 < n && !(p[i] == 0xFF && p[i + 1] != 0x00 && !(p[i + 1] >= 0xD0 && p[i + 1] <= 0xD7))) ++i;
+        }
+    }
+    return {};
+}
+
 }  // namespace
 
 size_t decoded_image_bytes(int width, int height) {
@@ -147,9 +189,11 @@ MipLevel decode_image_rgba8(const uint8_t* bytes, size_t size, size_t max_memory
             throw Error(loc, fmt::format("cannot decode image '{}': corrupt WebP data", label));
         return level;
     }
-    if (is_png(bytes, size))
-        if (const std::string refused = check_png_chunks(bytes, size); !refused.empty())
-            throw Error(loc, fmt::format("cannot decode image '{}': {}", label, refused));
+    if (const std::string refused = is_png(bytes, size)    ? check_png_chunks(bytes, size)
+                                    : is_jpeg(bytes, size) ? check_jpeg_tables(bytes, size)
+                                                           : std::string();
+        !refused.empty())
+        throw Error(loc, fmt::format("cannot decode image '{}': {}", label, refused));
 
     // Decode to RGBA, 16 bits per channel when the file has them.
     const int n = int(size);

@@ -169,6 +169,20 @@ TEST(HostileInput, ImageDimensionsAreCheckedFromTheHeaderBeforeDecoding) {
     // A chunk declaring more bytes than the file holds is refused before stb_image sizes a buffer by it.
     const std::string chunk = decode(read_bytes((regressions_dir() / "image" / "oom-png-idat-length-2gib.png").string()));
     EXPECT_NE(chunk.find("truncated PNG: chunk 'IDAT'"), std::string::npos) << chunk;
+    // A JPEG Huffman table of more than 256 codes is refused before stb_image writes past its table.
+    const std::string huffman =
+        decode(read_bytes((regressions_dir() / "image" / "ubsan-stbi-huffman-more-than-256-codes.jpg").string()));
+    EXPECT_NE(huffman.find("corrupt JPEG: Huffman table"), std::string::npos) << huffman;
+    // Every bundled JPEG still decodes (the check walks real files' segments and scans to the end).
+    size_t jpegs = 0;
+    for (const auto& e : fs::recursive_directory_iterator(fs::path(WHITTED_ASSETS_DIR) / "gltf")) {
+        const std::string ext = e.path().extension().string();
+        if (ext != ".jpg" && ext != ".jpeg") continue;
+        const std::vector<uint8_t> jpeg = read_bytes(e.path().string());
+        EXPECT_NO_THROW(decode_image_rgba8(jpeg.data(), jpeg.size(), size_t(1) << 30, {}, "x")) << e.path();
+        ++jpegs;
+    }
+    EXPECT_GT(jpegs, 0u);
     const std::vector<uint8_t> gif = {'G', 'I', 'F', '8', '9', 'a', 1, 0, 1, 0, 0, 0, 0};
     const std::string other = decode(gif);
     EXPECT_NE(other.find("not a PNG, JPEG or WebP image"), std::string::npos) << other;
