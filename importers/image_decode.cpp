@@ -4,19 +4,23 @@
 #include "importers/image_decode.h"
 
 #include <algorithm>
+#include <csetjmp>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 
 #include <fmt/format.h>
+#include <jpeglib.h>
 #include <webp/decode.h>
 
 // stb_image compiled here (Debian's libstb-dev header), not the copy inside the tinygltf shared
 // library: this one is built with the project's flags, so sanitizer and fuzzing builds instrument
-// it, and it is cut down to the glTF core formats with the side limit whitted enforces.
+// it, and it is cut down to PNG with the side limit whitted enforces. JPEG goes through
+// libjpeg-turbo (below): stb_image 2.27's JPEG decoder writes out of bounds on a Huffman table of
+// more than 256 codes (tests/data/fuzz-regressions/image/ubsan-stbi-huffman-*.jpg).
 #define STB_IMAGE_STATIC
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_ONLY_PNG
-#define STBI_ONLY_JPEG
 #define STBI_NO_STDIO
 #define STBI_MAX_DIMENSIONS 32768  // = kMaxImageSide (checked below)
 // stb_image 2.27 calls memcpy(NULL, src, 0) for a PNG whose first IDAT chunk is empty (no buffer
@@ -107,44 +111,89 @@ bool is_png(const uint8_t* p, size_t n) { return n >= 8 && std::memcmp(p, "\x89P
 
 bool is_jpeg(const uint8_t* p, size_t n) { return n >= 2 && p[0] == 0xFF && p[1] == 0xD8; }
 
-/// JPEG Huffman tables (DHT segments, ITU T.81 B.2.4.2) checked before stb_image sees them: a
-/// table holds at most 256 codes, and stb_image 2.27 writes one entry per declared code into a
-/// 257-entry array before checking the sum, out of bounds when the 16 counts add up to more
-/// (tests/data/fuzz-regressions/image/ubsan-stbi-huffman-more-than-256-codes.jpg). Walks every
-/// marker segment, the entropy-coded data after each SOS included (progressive files define tables
-/// between scans); a file cut short is left to the decoder. Returns the reason for refusing, or an
-/// empty string.
-std::string check_jpeg_tables(const uint8_t* p, size_t n) {
-    auto be16 = [&](size_t i) { return (size_t(p[i]) << 8) | p[i + 1]; };
-    size_t i = 2;  // after SOI
-    while (i + 4 <= n) {
-        if (p[i] != 0xFF) return {};  // not at a marker: the decoder reports it
-        const uint8_t marker = p[i + 1];
-        if (marker == 0xFF) {  // fill byte
-            ++i;
-            continue;
-        }
-        if (marker == 0xD9) return {};  // EOI
-        if (marker == 0xD8 || marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {
-            i += 2;
-            continue;
-        }
-        const size_t length = be16(i + 2), end = std::min(n, i + 2 + length);
-        if (marker == 0xC4) {
-            for (size_t t = i + 4; t + 17 <= end;) {
-                size_t codes = 0;
-                for (size_t k = 1; k <= 16; ++k) codes += p[t + k];
-                if (codes > 256)
-                    return fmt::format("corrupt JPEG: Huffman table at byte {} declares {} codes (at most 256)", t, codes);
-                t += 17 + codes;
-            }
-        }
-        i += 2 + length;
-        if (marker == 0xDA) {  // SOS: entropy-coded data up to the next marker (FF 00 is a stuffed FF, FF D0..D7 a restart)
-            while (i + 1 < n && !(p[i] == 0xFF && p[i + 1] != 0x00 && !(p[i + 1] >= 0xD0 && p[i + 1] <= 0xD7))) ++i;
+/// libjpeg reports errors through a longjmp out of the library call; warnings (corrupt data it
+/// recovers from) are not printed.
+struct JpegErrors {
+    jpeg_error_mgr mgr;
+    jpeg_progress_mgr progress;
+    std::jmp_buf jump;
+    char message[JMSG_LENGTH_MAX];
+};
+
+[[noreturn]] void jpeg_error_exit(j_common_ptr cinfo) {
+    auto* e = reinterpret_cast<JpegErrors*>(cinfo->err);
+    (*cinfo->err->format_message)(cinfo, e->message);
+    std::longjmp(e->jump, 1);
+}
+
+void jpeg_no_message(j_common_ptr, int) {}
+
+/// A progressive file may declare any number of scans, each a pass over the whole image: more than
+/// kMaxJpegScans is refused (as libjpeg-turbo's own fuzzers do), so a small file cannot keep the
+/// decoder busy for minutes.
+constexpr int kMaxJpegScans = 500;
+
+void jpeg_scan_limit(j_common_ptr cinfo) {
+    auto* d = reinterpret_cast<j_decompress_ptr>(cinfo);
+    if (d->input_scan_number > kMaxJpegScans) {
+        auto* e = reinterpret_cast<JpegErrors*>(cinfo->err);
+        std::snprintf(e->message, sizeof e->message, "more than %d progressive scans", kMaxJpegScans);
+        std::longjmp(e->jump, 1);
+    }
+}
+
+/// Decodes a JPEG of `w` x `h` pixels (the size image_size_from_header read and checked) into
+/// `level` as RGBA8 (alpha 255): baseline and progressive, grey, YCbCr/RGB and (Adobe) CMYK.
+/// Returns false with the reason in `why` (a buffer of JMSG_LENGTH_MAX bytes).
+bool decode_jpeg_rgba8(const uint8_t* bytes, size_t size, int w, int h, MipLevel& level, char* why) {
+    // Nothing with a destructor lives in this frame between setjmp and the calls that may jump back
+    // (`level` is the caller's).
+    jpeg_decompress_struct cinfo;
+    JpegErrors errors;
+    cinfo.err = jpeg_std_error(&errors.mgr);
+    errors.mgr.error_exit = jpeg_error_exit;
+    errors.mgr.emit_message = jpeg_no_message;
+    errors.message[0] = '\0';
+    if (setjmp(errors.jump)) {
+        jpeg_destroy_decompress(&cinfo);
+        std::snprintf(why, JMSG_LENGTH_MAX, "%s", errors.message);
+        return false;
+    }
+    jpeg_create_decompress(&cinfo);
+    errors.progress.progress_monitor = jpeg_scan_limit;
+    cinfo.progress = &errors.progress;
+    jpeg_mem_src(&cinfo, bytes, static_cast<unsigned long>(size));
+    jpeg_read_header(&cinfo, TRUE);
+    if (int(cinfo.image_width) != w || int(cinfo.image_height) != h) {
+        std::snprintf(why, JMSG_LENGTH_MAX, "the frame header says %ux%u, its first one %dx%d", cinfo.image_width,
+                      cinfo.image_height, w, h);
+        jpeg_destroy_decompress(&cinfo);
+        return false;
+    }
+    const bool cmyk = cinfo.jpeg_color_space == JCS_CMYK || cinfo.jpeg_color_space == JCS_YCCK;
+    cinfo.out_color_space = cmyk ? JCS_CMYK : JCS_EXT_RGBA;
+    jpeg_start_decompress(&cinfo);
+    level.width = w;
+    level.height = h;
+    level.texels.resize(size_t(w) * size_t(h) * 4);
+    while (cinfo.output_scanline < cinfo.output_height) {
+        JSAMPROW row = level.texels.data() + size_t(cinfo.output_scanline) * size_t(w) * 4;
+        jpeg_read_scanlines(&cinfo, &row, 1);
+    }
+    jpeg_finish_decompress(&cinfo);
+    jpeg_destroy_decompress(&cinfo);
+    if (cmyk) {
+        // Adobe's CMYK JPEGs store inverted values: RGB = (255 - C)(255 - K) as stored, i.e. c * k / 255.
+        for (size_t i = 0; i < level.texels.size(); i += 4) {
+            uint8_t* t = &level.texels[i];
+            const unsigned k = t[3];
+            t[0] = uint8_t((t[0] * k + 127) / 255);
+            t[1] = uint8_t((t[1] * k + 127) / 255);
+            t[2] = uint8_t((t[2] * k + 127) / 255);
+            t[3] = 255;
         }
     }
-    return {};
+    return true;
 }
 
 }  // namespace
@@ -189,11 +238,16 @@ MipLevel decode_image_rgba8(const uint8_t* bytes, size_t size, size_t max_memory
             throw Error(loc, fmt::format("cannot decode image '{}': corrupt WebP data", label));
         return level;
     }
-    if (const std::string refused = is_png(bytes, size)    ? check_png_chunks(bytes, size)
-                                    : is_jpeg(bytes, size) ? check_jpeg_tables(bytes, size)
-                                                           : std::string();
-        !refused.empty())
-        throw Error(loc, fmt::format("cannot decode image '{}': {}", label, refused));
+    if (is_png(bytes, size))
+        if (const std::string refused = check_png_chunks(bytes, size); !refused.empty())
+            throw Error(loc, fmt::format("cannot decode image '{}': {}", label, refused));
+    if (is_jpeg(bytes, size)) {
+        MipLevel level;
+        char why[JMSG_LENGTH_MAX];
+        if (!decode_jpeg_rgba8(bytes, size, header_w, header_h, level, why))
+            throw Error(loc, fmt::format("cannot decode image '{}': corrupt JPEG: {}", label, why));
+        return level;
+    }
 
     // Decode to RGBA, 16 bits per channel when the file has them.
     const int n = int(size);

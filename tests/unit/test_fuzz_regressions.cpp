@@ -169,10 +169,10 @@ TEST(HostileInput, ImageDimensionsAreCheckedFromTheHeaderBeforeDecoding) {
     // A chunk declaring more bytes than the file holds is refused before stb_image sizes a buffer by it.
     const std::string chunk = decode(read_bytes((regressions_dir() / "image" / "oom-png-idat-length-2gib.png").string()));
     EXPECT_NE(chunk.find("truncated PNG: chunk 'IDAT'"), std::string::npos) << chunk;
-    // A JPEG Huffman table of more than 256 codes is refused before stb_image writes past its table.
+    // A JPEG Huffman table of more than 256 codes (stb_image wrote past its table): libjpeg-turbo refuses it.
     const std::string huffman =
         decode(read_bytes((regressions_dir() / "image" / "ubsan-stbi-huffman-more-than-256-codes.jpg").string()));
-    EXPECT_NE(huffman.find("corrupt JPEG: Huffman table"), std::string::npos) << huffman;
+    EXPECT_NE(huffman.find("corrupt JPEG"), std::string::npos) << huffman;
     // Every bundled JPEG still decodes (the check walks real files' segments and scans to the end).
     size_t jpegs = 0;
     for (const auto& e : fs::recursive_directory_iterator(fs::path(WHITTED_ASSETS_DIR) / "gltf")) {
