@@ -4,14 +4,14 @@
 #include "importers/image_decode.h"
 
 #include <algorithm>
-#include <csetjmp>
 #include <cstdio>
 #include <cstring>
 #include <limits>
 
 #include <fmt/format.h>
-#include <jpeglib.h>
 #include <webp/decode.h>
+
+#include "renderer/core/jpeg_errors.h"
 
 // stb_image compiled here (Debian's libstb-dev header), not the copy inside the tinygltf shared
 // library: this one is built with the project's flags, so sanitizer and fuzzing builds instrument
@@ -48,6 +48,10 @@ bool is_webp(const uint8_t* p, size_t n) {
     return p != nullptr && n >= 12 && std::memcmp(p, "RIFF", 4) == 0 && std::memcmp(p + 8, "WEBP", 4) == 0;
 }
 
+namespace {
+bool is_jpeg(const uint8_t* p, size_t n) { return n >= 2 && p[0] == 0xFF && p[1] == 0xD8; }  // SOI
+}  // namespace
+
 bool image_size_from_header(const uint8_t* p, size_t n, int& w, int& h) {
     if (p == nullptr) return false;
     // WebP (EXT_texture_webp): libwebp reads the size from the VP8/VP8L/VP8X header alone.
@@ -61,7 +65,7 @@ bool image_size_from_header(const uint8_t* p, size_t n, int& w, int& h) {
         return true;
     }
     // JPEG: walk the marker segments to the first start-of-frame (ITU T.81 B.2).
-    if (n >= 4 && p[0] == 0xFF && p[1] == 0xD8) {
+    if (n >= 4 && is_jpeg(p, n)) {
         size_t i = 2;
         while (i + 9 < n) {
             if (p[i] != 0xFF) return false;
@@ -109,23 +113,7 @@ std::string check_png_chunks(const uint8_t* p, size_t n) {
 
 bool is_png(const uint8_t* p, size_t n) { return n >= 8 && std::memcmp(p, "\x89PNG\r\n\x1a\n", 8) == 0; }
 
-bool is_jpeg(const uint8_t* p, size_t n) { return n >= 2 && p[0] == 0xFF && p[1] == 0xD8; }
-
-/// libjpeg reports errors through a longjmp out of the library call; warnings (corrupt data it
-/// recovers from) are not printed.
-struct JpegErrors {
-    jpeg_error_mgr mgr;
-    jpeg_progress_mgr progress;
-    std::jmp_buf jump;
-    char message[JMSG_LENGTH_MAX];
-};
-
-[[noreturn]] void jpeg_error_exit(j_common_ptr cinfo) {
-    auto* e = reinterpret_cast<JpegErrors*>(cinfo->err);
-    (*cinfo->err->format_message)(cinfo, e->message);
-    std::longjmp(e->jump, 1);
-}
-
+/// Warnings (corrupt data libjpeg recovers from) are not printed.
 void jpeg_no_message(j_common_ptr, int) {}
 
 /// A progressive file may declare any number of scans, each a pass over the whole image: more than
@@ -149,7 +137,8 @@ bool decode_jpeg_rgba8(const uint8_t* bytes, size_t size, int w, int h, MipLevel
     // Nothing with a destructor lives in this frame between setjmp and the calls that may jump back
     // (`level` is the caller's).
     jpeg_decompress_struct cinfo;
-    JpegErrors errors;
+    JpegErrors errors;  // renderer/core/jpeg_errors.h
+    jpeg_progress_mgr progress;
     cinfo.err = jpeg_std_error(&errors.mgr);
     errors.mgr.error_exit = jpeg_error_exit;
     errors.mgr.emit_message = jpeg_no_message;
@@ -160,8 +149,8 @@ bool decode_jpeg_rgba8(const uint8_t* bytes, size_t size, int w, int h, MipLevel
         return false;
     }
     jpeg_create_decompress(&cinfo);
-    errors.progress.progress_monitor = jpeg_scan_limit;
-    cinfo.progress = &errors.progress;
+    progress.progress_monitor = jpeg_scan_limit;
+    cinfo.progress = &progress;
     jpeg_mem_src(&cinfo, bytes, static_cast<unsigned long>(size));
     jpeg_read_header(&cinfo, TRUE);
     if (int(cinfo.image_width) != w || int(cinfo.image_height) != h) {

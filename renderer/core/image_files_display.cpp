@@ -17,6 +17,7 @@
 #include <libdeflate.h>
 
 #include "renderer/core/error.h"
+#include "renderer/core/jpeg_errors.h"
 
 namespace whitted {
 
@@ -41,19 +42,6 @@ std::string other_attributes(const ImageDesc& desc, std::initializer_list<std::s
         text += (text.empty() ? "" : "\n") + key + ": " + value;
     }
     return text;
-}
-
-/// libjpeg reports errors through a longjmp out of the library call.
-struct JpegErrors {
-    jpeg_error_mgr mgr;
-    std::jmp_buf jump;
-    char message[JMSG_LENGTH_MAX];
-};
-
-void jpeg_error_exit(j_common_ptr cinfo) {
-    auto* e = reinterpret_cast<JpegErrors*>(cinfo->err);
-    (*cinfo->err->format_message)(cinfo, e->message);
-    std::longjmp(e->jump, 1);
 }
 
 struct FileCloser {
