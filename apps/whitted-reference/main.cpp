@@ -3,7 +3,6 @@
 // --texture-filter none --exr-float` (docs/integrator.md, "The reference renderer").
 #include <CLI/CLI.hpp>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -70,9 +69,7 @@ int main(int argc, char** argv) {
         // and texture filtering are the reference's own.
         apply_scene_settings(scene.settings, rs, [&](std::string_view key) {
             if (key == "aa" || key == "min_weight") return true;
-            std::string flag = "--" + std::string(key);
-            std::replace(flag.begin(), flag.end(), '_', '-');
-            const CLI::Option* option = app.get_option_no_throw(flag);
+            const CLI::Option* option = app.get_option_no_throw(setting_flag(key));
             return option != nullptr && option->count() > 0;
         });
         const auto start = std::chrono::steady_clock::now();

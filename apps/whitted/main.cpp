@@ -602,11 +602,7 @@ int main(int argc, char** argv) {
         if (g_mpi && g_mpi->rank() > 0) set_log_level(std::max(parse_log_level(log_level), LogLevel::Error));
         if (render->parsed()) {
             // A setting's scene-file key names its flag: aa_threshold -> --aa-threshold.
-            const SettingGiven flag_given = [&](std::string_view key) {
-                std::string flag = "--" + std::string(key);
-                std::replace(flag.begin(), flag.end(), '_', '-');
-                return render->count(flag) > 0;
-            };
+            const SettingGiven flag_given = [&](std::string_view key) { return render->count(setting_flag(key)) > 0; };
             return run_render(rc, command_line(argc, argv), flag_given, g_mpi);
         }
         if (info->parsed()) return run_info(info_input, info_import);

@@ -297,6 +297,13 @@ struct SceneRenderSettings {
 /// ("width", "aa_threshold", "output", ...): such a setting wins over the file's. Empty = none.
 using SettingGiven = std::function<bool(std::string_view key)>;
 
+/// The command-line flag of a scene-file setting: "aa_threshold" -> "--aa-threshold".
+inline std::string setting_flag(std::string_view key) {
+    std::string flag = "--";
+    for (const char c : key) flag += c == '_' ? '-' : c;
+    return flag;
+}
+
 // ---------------------------------------------------------------------------------------------
 
 struct Scene {
