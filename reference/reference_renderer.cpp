@@ -186,6 +186,7 @@ private:
         V3 p_shadow;        ///< shadow-ray origin before the offset (Hanika's lift, as production)
         double scale = 0.0; ///< magnitude of the primitive's coordinates (for the offset)
         V3 ng, ns;          ///< unit geometric (front by winding) and shading normals
+        double normal_spread = 0.0;  ///< max |n_i - n_j| of the triangle's world-space vertex normals
         Vec2f uv[2]{};
         Vec4f color{1.f, 1.f, 1.f, 1.f};
         uint32_t material = 0;
@@ -269,6 +270,10 @@ private:
             const auto n = interp(mesh.normals, idx, w0, w1, w2);
             const V3 wn = normalize(m_normal_xf[hit.inst].apply_vector({n[0], n[1], n[2]}));
             if (wn != V3(0.0) && is_finite(wn)) s.ns = wn;
+            V3 vn[3];
+            for (int k = 0; k < 3; ++k) vn[k] = normalize(m_normal_xf[hit.inst].apply_vector(V3(mesh.normals[idx[k]])));
+            s.normal_spread = std::max({length(vn[0] - vn[1]), length(vn[1] - vn[2]), length(vn[2] - vn[0])});
+            if (!std::isfinite(s.normal_spread)) s.normal_spread = 0.0;
         }
         const Material& mat = m_scene.materials[mesh.material];
         if (mat.model == MaterialModel::GltfPbr && mat.normal_texture.valid() && !mesh.tangents.empty()) {
@@ -525,6 +530,14 @@ private:
         rec.geom = hit.geom, rec.inst = hit.inst, rec.prim = hit.prim, rec.t = hit.t;
         rec.edge = m_scene.geom_kind(hit.geom) == GeomKind::Mesh ? std::min({1.0 - hit.b1 - hit.b2, hit.b1, hit.b2}) : 1.0;
         rec.cos = std::fabs(dot(s.ng, ray.dir));
+        rec.b1 = hit.b1, rec.b2 = hit.b2;
+        rec.normal_spread = s.normal_spread;
+        if (m_scene.geom_kind(hit.geom) == GeomKind::Mesh) {
+            const Triangle& tri = m_instances[hit.inst].tris[hit.prim];
+            const double twice_area = length(cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]));
+            const double longest = std::max({length(tri.v[1] - tri.v[0]), length(tri.v[2] - tri.v[1]), length(tri.v[0] - tri.v[2])});
+            rec.altitude = longest > 0.0 ? twice_area / longest : 0.0;
+        }
         const WhittedCoeffs c = coefficients(s);
         rec.textured = m_textured;
         const size_t rec_index = m_tree->size();
@@ -597,6 +610,7 @@ private:
             if (black(term)) continue;  // 0 whatever s is
             if (!black(to_v3(c.ks)) && std::pow(n_dot_h, double(c.n)) > 1e-6) rec.highlight_n = std::max(rec.highlight_n, double(c.n));
             if (spot > 0.0 && spot < 1.0) rec.spot_ramp = true;
+            rec.min_n_dot_l = std::min(rec.min_n_dot_l, n_dot_l);
             // s: a shadow ray from the point (moved off the surface) toward the light.
             RRay shadow = spawn(s, org, Ng, L);
             if (light.type != LightType::Directional) {

@@ -38,6 +38,12 @@ struct ReferenceHitRecord {
                                      ///< (N.H)^n multiplies a relative error of N.H by n
     bool textured = false;           ///< an image texture was read (its value follows the UV's rounding)
     bool spot_ramp = false;          ///< a spot light lit it from between its inner and outer cone
+    double b1 = 0.0, b2 = 0.0;       ///< triangles: the barycentrics of vertices 1 and 2 (as Hit::u, v)
+    double normal_spread = 0.0;      ///< triangles with vertex normals: max |n_i - n_j| of the world-space
+                                     ///< vertex normals (how far a barycentric error moves the shading normal)
+    double altitude = 0.0;           ///< triangles: the smallest altitude (world space); a hit moved by e along
+                                     ///< the surface changes the barycentrics by up to e / altitude
+    double min_n_dot_l = 1.0;        ///< smallest N.L of a light that lit it (a small one scales an error of N up)
     bool operator==(const ReferenceHitRecord& o) const { return geom == o.geom && inst == o.inst && prim == o.prim; }
 };
 
