@@ -108,6 +108,24 @@ BENCHMARK_CAPTURE(write_exr_half, rle, std::string("rle"))->Unit(benchmark::kMil
 BENCHMARK_CAPTURE(write_exr_half, zips_1, std::string("zips:1"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(write_exr_half, piz, std::string("piz"))->Unit(benchmark::kMillisecond)->UseRealTime();
 
+void write_exr_float(benchmark::State& state, const std::string& compression) {
+    // The beauty as 32-bit float (--exr-float) with the given compression.
+    std::vector<float> rgb;
+    rgb.reserve(film().beauty.size() * 3);
+    for (const Color& c : film().beauty)
+        for (float v : {c.x, c.y, c.z}) rgb.push_back(v);
+    const ImageDesc desc = rgb_desc("openexr", PixelType::Float, compression);
+    const fs::path file = scratch(".exr");
+    for (auto _ : state) write_image_file(file.string(), desc, rgb.data());
+    state.counters["bytes"] = double(fs::file_size(file));
+    fs::remove(file);
+}
+BENCHMARK_CAPTURE(write_exr_float, zip_1, std::string("zip:1"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(write_exr_float, none, std::string("none"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(write_exr_float, rle, std::string("rle"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(write_exr_float, zips_1, std::string("zips:1"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(write_exr_float, piz, std::string("piz"))->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_WriteTiff16Level(benchmark::State& state) {
     // 16-bit display codes as write_image makes them for TIFF, deflate level N.
     std::vector<uint8_t> codes16(film().beauty.size() * 6);

@@ -109,6 +109,19 @@ def test_display_is_what_render_writes_to_png(glb, tmp_path):
         whitted.display(np.zeros((4, 4)))
 
 
+def test_write_exr_compression_keyword(glb, tmp_path):
+    img = whitted.render(glb, width=32, aa="center")
+    sizes = {}
+    for method in ("zip", "none", "piz"):
+        exr = tmp_path / f"{method}.exr"
+        whitted.write(img, str(exr), exr_float=True, exr_compression=method)
+        assert np.array_equal(whitted.read_image(str(exr)), img.beauty)  # lossless
+        sizes[method] = exr.stat().st_size
+    assert sizes["none"] > sizes["zip"]
+    with pytest.raises(whitted.Error, match="unknown EXR compression 'b44'"):
+        whitted.write(img, str(tmp_path / "bad.exr"), exr_compression="b44")
+
+
 def test_ray_queries_agree_across_accelerators(glb):
     rng = np.random.default_rng(7)
     n = 20000

@@ -322,7 +322,7 @@ EncodedImage encode_exr(const Film& film, const OutputSettings& settings) {
     desc.full_y = 0;
     desc.full_width = film.full_width;
     desc.full_height = film.full_height;
-    desc.attributes.emplace_back("compression", "zip");
+    desc.attributes.emplace_back("compression", settings.exr_compression);
 
     // Pack the pixels in the file's native per-channel layout, so ids stay exact 32-bit values.
     const size_t n = film.beauty.size();
@@ -496,12 +496,29 @@ void apply_scene_output_settings(const SceneRenderSettings& s, const std::string
     }
 }
 
+std::string exr_compression_error(const std::string& name) {
+    const size_t colon = name.find(':');
+    const std::string method = name.substr(0, colon);
+    if (method != "none" && method != "rle" && method != "zips" && method != "zip" && method != "piz")
+        return fmt::format("unknown EXR compression '{}' (use none, rle, zips, zip or piz; zip and zips take a "
+                           "level, e.g. zip:6)", name);
+    if (colon == std::string::npos) return {};
+    const std::string level = name.substr(colon + 1);
+    if (method != "zip" && method != "zips") return fmt::format("EXR compression '{}' takes no level", method);
+    if (level.size() != 1 || level[0] < '1' || level[0] > '9')
+        return fmt::format("EXR compression '{}': the zlib level is 1 to 9", name);
+    return {};
+}
+
 void write_image(const Film& film, const std::string& path, const OutputSettings& settings) {
     const fs::path file(path);
     const std::optional<FileKind> kind = kind_from_extension(file.extension().string());
     if (!kind)
         throw Error(fmt::format("{}: unsupported image extension '{}' (supported: {})", path,
                                 file.extension().string(), kSupportedExtensions));
+    if (*kind == FileKind::Exr)
+        if (const std::string why = exr_compression_error(settings.exr_compression); !why.empty())
+            throw Error(fmt::format("{}: {}", path, why));
     validate_film(film, path);
 
     EncodedImage image =

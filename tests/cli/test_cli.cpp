@@ -122,6 +122,22 @@ TEST(Cli, EmbreeRobustIsTheDefaultAndNoRobustTurnsItOff) {
     EXPECT_NE(r.err.find("accelerator: embree (not robust"), std::string::npos) << r.err;
 }
 
+TEST(Cli, ExrCompressionFlagWritesTheMethodAndRejectsOthers) {
+    const fs::path out = fs::temp_directory_path() / "whitted_cli_exr_none.exr";
+    const fs::path zip = fs::temp_directory_path() / "whitted_cli_exr_zip.exr";
+    Result r = run("render '" + kBox + "' --width 32 --aa center --no-progress --exr-float --exr-compression none -o '" +
+                   out.string() + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = run("render '" + kBox + "' --width 32 --aa center --no-progress --exr-float -o '" + zip.string() + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(whitted::test::read_pixels(out), whitted::test::read_pixels(zip));  // lossless both ways
+    EXPECT_GT(fs::file_size(out), fs::file_size(zip));
+    r = run("render '" + kBox + "' --width 32 --no-progress --exr-compression dwaa -o /tmp/whitted_cli_exr_bad.exr");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("unknown EXR compression 'dwaa'"), std::string::npos) << r.err;
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+}
+
 TEST(Cli, UnknownOutputExtensionIsAnErrorAndWritesNothing) {
     const fs::path out = fs::temp_directory_path() / "whitted_cli_out.xyz";
     fs::remove(out);
