@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <unistd.h>
@@ -89,17 +90,25 @@ ImageDesc rgb_desc(const char* format, PixelType type, const std::string& compre
     return desc;
 }
 
-void write_exr_half(benchmark::State& state, const std::string& compression) {
-    // The beauty as half, as write_image writes it, with the given compression.
-    std::vector<Imath::half> half;
-    half.reserve(film().beauty.size() * 3);
+/// The beauty as T (half, as write_image writes it, or float: --exr-float) with the given compression.
+template <typename T>
+void write_exr_beauty(benchmark::State& state, const std::string& compression) {
+    std::vector<T> rgb;
+    rgb.reserve(film().beauty.size() * 3);
     for (const Color& c : film().beauty)
-        for (float v : {c.x, c.y, c.z}) half.emplace_back(v);
-    const ImageDesc desc = rgb_desc("openexr", PixelType::Half, compression);
+        for (float v : {c.x, c.y, c.z}) rgb.emplace_back(v);
+    const PixelType type = std::is_same_v<T, float> ? PixelType::Float : PixelType::Half;
+    const ImageDesc desc = rgb_desc("openexr", type, compression);
     const fs::path file = scratch(".exr");
-    for (auto _ : state) write_image_file(file.string(), desc, half.data());
+    for (auto _ : state) write_image_file(file.string(), desc, rgb.data());
     state.counters["bytes"] = double(fs::file_size(file));
     fs::remove(file);
+}
+void write_exr_half(benchmark::State& state, const std::string& compression) {
+    write_exr_beauty<Imath::half>(state, compression);
+}
+void write_exr_float(benchmark::State& state, const std::string& compression) {
+    write_exr_beauty<float>(state, compression);
 }
 void BM_WriteExrZipLevel(benchmark::State& state) { write_exr_half(state, "zip:" + std::to_string(state.range(0))); }
 BENCHMARK(BM_WriteExrZipLevel)->DenseRange(1, 9)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -108,18 +117,6 @@ BENCHMARK_CAPTURE(write_exr_half, rle, std::string("rle"))->Unit(benchmark::kMil
 BENCHMARK_CAPTURE(write_exr_half, zips_1, std::string("zips:1"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(write_exr_half, piz, std::string("piz"))->Unit(benchmark::kMillisecond)->UseRealTime();
 
-void write_exr_float(benchmark::State& state, const std::string& compression) {
-    // The beauty as 32-bit float (--exr-float) with the given compression.
-    std::vector<float> rgb;
-    rgb.reserve(film().beauty.size() * 3);
-    for (const Color& c : film().beauty)
-        for (float v : {c.x, c.y, c.z}) rgb.push_back(v);
-    const ImageDesc desc = rgb_desc("openexr", PixelType::Float, compression);
-    const fs::path file = scratch(".exr");
-    for (auto _ : state) write_image_file(file.string(), desc, rgb.data());
-    state.counters["bytes"] = double(fs::file_size(file));
-    fs::remove(file);
-}
 BENCHMARK_CAPTURE(write_exr_float, zip_1, std::string("zip:1"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(write_exr_float, none, std::string("none"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(write_exr_float, rle, std::string("rle"))->Unit(benchmark::kMillisecond)->UseRealTime();
