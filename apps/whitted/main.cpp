@@ -29,6 +29,7 @@
 #include "renderer/accel/accelerator.h"
 #include "renderer/core/error.h"
 #include "renderer/core/huge_pages.h"
+#include "renderer/core/image_files_exr.h"
 #include "renderer/core/log.h"
 #include "renderer/integrator/render.h"
 #include "renderer/output/image_output.h"

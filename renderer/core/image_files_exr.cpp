@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <fstream>
@@ -22,6 +21,8 @@
 #include <ImfStandardAttributes.h>
 #include <ImfStringAttribute.h>
 #include <ImfThreading.h>
+
+#include <fmt/format.h>
 
 #include "renderer/core/error.h"
 
@@ -61,13 +62,34 @@ const char* compression_name(Imf::Compression c) {
     }
 }
 
-Imf::Compression compression_from(const std::string& name) {
-    if (name == "none") return Imf::NO_COMPRESSION;
-    if (name == "rle") return Imf::RLE_COMPRESSION;
-    if (name == "zips") return Imf::ZIPS_COMPRESSION;
-    if (name == "piz") return Imf::PIZ_COMPRESSION;
-    if (name == "pxr24") return Imf::PXR24_COMPRESSION;
-    return Imf::ZIP_COMPRESSION;
+/// A "compression" attribute the writer takes: a lossless codec, zip and zips with an optional
+/// zlib level ("zip:6"; default 1, chosen by measurement on a 1920x1080 half beauty,
+/// benchmarks/bench_output.cpp, docs/measurements/performance.md "Output": 10 % larger than level 3
+/// at 3/4 of the time). A file without the attribute is written zip:1.
+struct ExrCompression {
+    Imf::Compression codec = Imf::ZIP_COMPRESSION;
+    int level = 1;
+};
+
+/// Parses `name` into `out`; returns why not when it is not one the writer takes.
+std::string parse_compression(const std::string& name, ExrCompression& out) {
+    const size_t colon = name.find(':');
+    const std::string method = name.substr(0, colon);
+    if (method == "none") out.codec = Imf::NO_COMPRESSION;
+    else if (method == "rle") out.codec = Imf::RLE_COMPRESSION;
+    else if (method == "zips") out.codec = Imf::ZIPS_COMPRESSION;
+    else if (method == "zip") out.codec = Imf::ZIP_COMPRESSION;
+    else if (method == "piz") out.codec = Imf::PIZ_COMPRESSION;
+    else
+        return fmt::format("unknown EXR compression '{}' (use none, rle, zips, zip or piz; zip and zips take a "
+                           "level, e.g. zip:6)", name);
+    if (colon == std::string::npos) return {};
+    const std::string level = name.substr(colon + 1);
+    if (method != "zip" && method != "zips") return fmt::format("EXR compression '{}' takes no level", method);
+    if (level.size() != 1 || level[0] < '1' || level[0] > '9')
+        return fmt::format("EXR compression '{}': the zlib level is 1 to 9", name);
+    out.level = level[0] - '0';
+    return {};
 }
 
 /// OpenEXR's worker threads, once: all cores (files are identical for any count).
@@ -179,6 +201,11 @@ std::unique_ptr<ImageFileReader> open_exr_file(const std::string& path) {
     }
 }
 
+std::string exr_compression_error(const std::string& name) {
+    ExrCompression unused;
+    return parse_compression(name, unused);
+}
+
 void write_exr_file(const std::string& path, const ImageDesc& desc, const void* pixels, void (*before_pixels)()) {
     use_all_cores();
     if (desc.width <= 0 || desc.height <= 0 || desc.channels() == 0) throw Error("empty image");
@@ -188,17 +215,11 @@ void write_exr_file(const std::string& path, const ImageDesc& desc, const void* 
     const Imath::Box2i display(Imath::V2i(desc.full_x, desc.full_y), Imath::V2i(desc.full_x + fw - 1, desc.full_y + fh - 1));
     try {
         Imf::Header header(display, data);
-        // "zip" or "zip:N" (OIIO's spelling of a zlib level). Level 1 by default, chosen by
-        // measurement on a 1920x1080 half beauty (benchmarks/bench_output.cpp,
-        // docs/measurements/performance.md "Output"): 10 % larger than level 3 at 3/4 of the time.
-        const std::string compression = desc.attribute("compression");
-        const size_t colon = compression.find(':');
-        header.compression() = compression_from(compression.substr(0, colon));
-        header.zipCompressionLevel() = 1;
-        if (colon != std::string::npos) {
-            const int level = std::atoi(compression.c_str() + colon + 1);
-            if (level >= 1 && level <= 9) header.zipCompressionLevel() = level;
-        }
+        ExrCompression compression;
+        if (const std::string name = desc.attribute("compression"); !name.empty())
+            if (const std::string why = parse_compression(name, compression); !why.empty()) throw Error(why);
+        header.compression() = compression.codec;
+        header.zipCompressionLevel() = compression.level;
         for (const auto& [key, value] : desc.attributes)
             if (key != "compression") header.insert(key, Imf::StringAttribute(value));
         const size_t pixel = desc.pixel_bytes();

@@ -36,6 +36,7 @@
 #include "renderer/core/data_files.h"
 #include "renderer/core/error.h"
 #include "renderer/core/image_files.h"
+#include "renderer/core/image_files_exr.h"
 #include "renderer/core/log.h"
 #include "renderer/output/png_encoder.h"
 namespace OCIO = OCIO_NAMESPACE;
@@ -494,20 +495,6 @@ void apply_scene_output_settings(const SceneRenderSettings& s, const std::string
         const fs::path out(*s.output);
         output_path = out.is_absolute() ? out.string() : (fs::path(scene_path).parent_path() / out).string();
     }
-}
-
-std::string exr_compression_error(const std::string& name) {
-    const size_t colon = name.find(':');
-    const std::string method = name.substr(0, colon);
-    if (method != "none" && method != "rle" && method != "zips" && method != "zip" && method != "piz")
-        return fmt::format("unknown EXR compression '{}' (use none, rle, zips, zip or piz; zip and zips take a "
-                           "level, e.g. zip:6)", name);
-    if (colon == std::string::npos) return {};
-    const std::string level = name.substr(colon + 1);
-    if (method != "zip" && method != "zips") return fmt::format("EXR compression '{}' takes no level", method);
-    if (level.size() != 1 || level[0] < '1' || level[0] > '9')
-        return fmt::format("EXR compression '{}': the zlib level is 1 to 9", name);
-    return {};
 }
 
 void write_image(const Film& film, const std::string& path, const OutputSettings& settings) {

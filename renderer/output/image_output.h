@@ -60,15 +60,11 @@ struct OutputSettings {
     int bits = 0;                         ///< 8 or 16 for PNG/TIFF; 0 = 8 (PNG/JPEG), 16 (TIFF)
     bool exr_half = true;                 ///< EXR beauty as half (true) or float (false)
     /// EXR compression, all lossless: none, rle, zips, zip, piz; zip and zips take a zlib level,
-    /// "zip:6" (default 1). "zip" by default; "none" writes a float beauty about 3x faster at 3x the
+    /// "zip:6" (default 1); exr_compression_error (renderer/core/image_files_exr.h) checks it. "zip" by default; "none" writes a float beauty about 3x faster at 3x the
     /// bytes (docs/performance.md, "Output").
     std::string exr_compression = "zip";
     std::map<std::string, std::string> metadata;  ///< written into EXR headers (and PNG text)
 };
-
-/// Empty when `name` is an EXR compression OutputSettings::exr_compression accepts, else why not
-/// (for one error line).
-std::string exr_compression_error(const std::string& name);
 
 /// Fills the output settings the caller did not set (`given`) from a scene file's: the output
 /// path ("output"; a relative one is taken relative to the folder of `scene_path`, the scene file,
