@@ -187,6 +187,7 @@ private:
         double scale = 0.0; ///< magnitude of the primitive's coordinates (for the offset)
         V3 ng, ns;          ///< unit geometric (front by winding) and shading normals
         double normal_spread = 0.0;  ///< max |n_i - n_j| of the triangle's world-space vertex normals
+        double altitude = 0.0;       ///< the triangle's smallest altitude (world space)
         Vec2f uv[2]{};
         Vec4f color{1.f, 1.f, 1.f, 1.f};
         uint32_t material = 0;
@@ -244,7 +245,10 @@ private:
         s.material = mesh.material;
         s.p = s.p_shadow = tri.v[0] * w0 + tri.v[1] * w1 + tri.v[2] * w2;
         s.scale = std::max({max_abs(tri.v[0]), max_abs(tri.v[1]), max_abs(tri.v[2])});
-        s.ng = normalize(cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]));
+        const V3 twice_area = cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]);
+        s.ng = normalize(twice_area);
+        const double longest = std::max({length(tri.v[1] - tri.v[0]), length(tri.v[2] - tri.v[1]), length(tri.v[0] - tri.v[2])});
+        s.altitude = longest > 0.0 ? length(twice_area) / longest : 0.0;
         if (!is_finite(s.ng) || s.ng == V3(0.0)) s.ng = -ray.dir;  // degenerate triangle: face the ray
         const Mat4d& world = m_scene.instances[hit.inst].world_from_object;
         if (!mesh.normals.empty()) {
@@ -532,12 +536,7 @@ private:
         rec.cos = std::fabs(dot(s.ng, ray.dir));
         rec.b1 = hit.b1, rec.b2 = hit.b2;
         rec.normal_spread = s.normal_spread;
-        if (m_scene.geom_kind(hit.geom) == GeomKind::Mesh) {
-            const Triangle& tri = m_instances[hit.inst].tris[hit.prim];
-            const double twice_area = length(cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]));
-            const double longest = std::max({length(tri.v[1] - tri.v[0]), length(tri.v[2] - tri.v[1]), length(tri.v[0] - tri.v[2])});
-            rec.altitude = longest > 0.0 ? twice_area / longest : 0.0;
-        }
+        rec.altitude = s.altitude;
         const WhittedCoeffs c = coefficients(s);
         rec.textured = m_textured;
         const size_t rec_index = m_tree->size();

@@ -314,8 +314,6 @@ TEST(AccelBatch, MeshesWithInstancesCutOutsAndCulling) { check_batches(batch_mes
 
 TEST(AccelBatch, SpheresAndPlanesToo) { check_batches(batch_analytic_scene(), "analytic"); }
 
-/// Embree's stats report what its memory monitor counted: the BVHs (the vertex and index arrays
-/// are shared with the Scene), less with RTC_SCENE_FLAG_COMPACT.
 /// Three coincident copies of one height field: mesh 0 in instances 0 and 1 (instanced), and
 /// mesh 1, its copy with every triangle listed twice (prim i and prim i + n coincide), alone in
 /// instance 2. Every hit on the surface is an exact tie between copies.
@@ -411,6 +409,8 @@ TEST(AccelTies, ExactTiesGoToTheSmallestIds) {
     }
 }
 
+/// Embree's stats report what its memory monitor counted: the BVHs (the vertex and index arrays
+/// are shared with the Scene), less with RTC_SCENE_FLAG_COMPACT.
 TEST(AccelEmbreeStats, BytesAreTheMemoryMonitorsCount) {
     const Scene s = batch_mesh_scene();
     const CullingFilter filter(s);
