@@ -91,7 +91,7 @@ void set_poles(EnvironmentMap::Level& level) {
 
 /// Next MIP level: each texel is the solid-angle weighted mean of the source texels its
 /// footprint covers (a 2x2 box for even sizes, overlap-weighted for odd ones).
-EnvironmentMap::Level downsample(const EnvironmentMap::Level& src) {
+EnvironmentMap::Level downsample(const EnvironmentMap::Level& src, WorkerPool& pool) {
     EnvironmentMap::Level dst;
     dst.width = std::max(1, src.width / 2);
     dst.height = std::max(1, src.height / 2);
@@ -103,7 +103,8 @@ EnvironmentMap::Level downsample(const EnvironmentMap::Level& src) {
     for (size_t y = 0; y < down.size(); ++y)
         for (const Tap& ty : down[y])
             row_weight[y].push_back(std::cos(kPiD * ty.a / src.height) - std::cos(kPiD * ty.b / src.height));
-    for (int y = 0; y < dst.height; ++y)
+    pool.for_each(size_t(dst.height), [&](size_t row, int) {
+        const int y = int(row);
         for (int x = 0; x < dst.width; ++x) {
             Vec3d sum(0.0);
             double weight = 0;
@@ -118,15 +119,16 @@ EnvironmentMap::Level downsample(const EnvironmentMap::Level& src) {
             }
             dst.texels[size_t(y) * size_t(dst.width) + size_t(x)] = Color(weight > 0 ? sum / weight : Vec3d(0.0));
         }
+    });
     set_poles(dst);
     return dst;
 }
 
 /// MIP pyramid from `base` down to 1 x 1.
-std::vector<EnvironmentMap::Level> pyramid(EnvironmentMap::Level base) {
+std::vector<EnvironmentMap::Level> pyramid(EnvironmentMap::Level base, WorkerPool& pool) {
     std::vector<EnvironmentMap::Level> levels;
     levels.push_back(std::move(base));
-    while (levels.back().width > 1 || levels.back().height > 1) levels.push_back(downsample(levels.back()));
+    while (levels.back().width > 1 || levels.back().height > 1) levels.push_back(downsample(levels.back(), pool));
     return levels;
 }
 
@@ -289,10 +291,33 @@ std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::L
         }
         out.push_back(std::move(level));
     }
+    // The samples' GGX half-vector angles, pdf and MIP level are the same for every texel of a
+    // level: computed once per level, then only turned into each texel's frame.
+    struct Sample {
+        float t, b, n;  // h = t sin_h cos(phi) + b sin_h sin(phi) + n cos_h, in the texel's frame
+        float lod;
+    };
+    std::vector<std::vector<Sample>> samples(kPrefilterRoughness.size());
+    for (size_t k = 0; k < kPrefilterRoughness.size(); ++k) {
+        if (((levels >> k) & 1u) == 0) continue;
+        const float alpha = kPrefilterRoughness[k] * kPrefilterRoughness[k];
+        const float a2 = alpha * alpha;
+        for (int s = 0; s < kPrefilterSamples; ++s) {
+            // GGX half vector (normal = view = n), its reflection l, pdf(l) = D(h) / 4.
+            const float xi1 = (float(s) + 0.5f) / float(kPrefilterSamples), xi2 = radical_inverse2(uint32_t(s));
+            const float cos2 = (1.f - xi1) / (1.f + (a2 - 1.f) * xi1);
+            const float cos_h = std::sqrt(cos2), sin_h = std::sqrt(std::max(0.f, 1.f - cos2));
+            const float phi = 2.f * kPi * xi2;
+            const float denom = cos2 * (a2 - 1.f) + 1.f;
+            const float pdf = a2 / (kPi * denom * denom) * 0.25f;
+            const float sample_sr = 1.f / (float(kPrefilterSamples) * pdf);
+            const float lod = std::max(0.f, 0.5f * std::log2(sample_sr / float(texel_sr)) + 1.f);
+            samples[k].push_back({sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h, lod});
+        }
+    }
     pool.for_each(rows.size(), [&](size_t item, int) {
         EnvironmentMap::Level& level = out[rows[item].level];
-        const float alpha = kPrefilterRoughness[rows[item].level] * kPrefilterRoughness[rows[item].level];
-        const float a2 = alpha * alpha;
+        const std::vector<Sample>& pattern = samples[rows[item].level];
         const int y = rows[item].y;
         for (int x = 0; x < level.width; ++x) {
             const Vec3f n = latlong_direction((float(x) + 0.5f) / float(level.width), (float(y) + 0.5f) / float(level.height));
@@ -300,21 +325,12 @@ std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::L
             tangent_frame(n, t, b);
             Color sum(0.f);
             float weight = 0.f;
-            for (int s = 0; s < kPrefilterSamples; ++s) {
-                // GGX half vector (normal = view = n), its reflection l, pdf(l) = D(h) / 4.
-                const float xi1 = (float(s) + 0.5f) / float(kPrefilterSamples), xi2 = radical_inverse2(uint32_t(s));
-                const float cos2 = (1.f - xi1) / (1.f + (a2 - 1.f) * xi1);
-                const float cos_h = std::sqrt(cos2), sin_h = std::sqrt(std::max(0.f, 1.f - cos2));
-                const float phi = 2.f * kPi * xi2;
-                const Vec3f h = t * (sin_h * std::cos(phi)) + b * (sin_h * std::sin(phi)) + n * cos_h;
-                const Vec3f l = h * (2.f * cos_h) - n;
+            for (const Sample& s : pattern) {
+                const Vec3f h = t * s.t + b * s.b + n * s.n;
+                const Vec3f l = h * (2.f * s.n) - n;
                 const float n_dot_l = dot(n, l);
                 if (n_dot_l <= 0.f) continue;
-                const float denom = cos2 * (a2 - 1.f) + 1.f;
-                const float pdf = a2 / (kPi * denom * denom) * 0.25f;
-                const float sample_sr = 1.f / (float(kPrefilterSamples) * pdf);
-                const float lod = std::max(0.f, 0.5f * std::log2(sample_sr / float(texel_sr)) + 1.f);
-                sum += sample_pyramid(source, l, lod) * n_dot_l;
+                sum += sample_pyramid(source, l, s.lod) * n_dot_l;
                 weight += n_dot_l;
             }
             level.texels[size_t(y) * size_t(level.width) + size_t(x)] = weight > 0.f ? sum / weight : Color(0.f);
@@ -443,27 +459,33 @@ EnvironmentMap::EnvironmentMap(const Environment& env, int threads, Use use, uin
     m_cos = float(std::cos(angle));
     m_sin = float(std::sin(angle));
 
-    // Level 0: the image at its exposure; negative and non-finite texels count as black.
+    // Every pass below runs over rows in parallel; sums over rows are added up in row order, so
+    // the map is the same for any thread count.
+    WorkerPool pool(threads);
+
+    // Level 0: the image at its exposure; negative and non-finite texels count as black. With it,
+    // each row's sum for the solid-angle weighted mean radiance.
     const float scale = std::exp2(env.exposure_stops);
     Level base;
     base.width = image.width;
     base.height = image.height;
     base.texels.resize(image.texels.size());
-    for (size_t i = 0; i < image.texels.size(); ++i) {
-        const Color c = image.texels[i] * scale;
-        base.texels[i] = {std::isfinite(c.x) ? std::max(c.x, 0.f) : 0.f, std::isfinite(c.y) ? std::max(c.y, 0.f) : 0.f,
-                          std::isfinite(c.z) ? std::max(c.z, 0.f) : 0.f};
-    }
+    std::vector<Vec3d> row_sums(size_t(base.height), Vec3d(0.0));
+    pool.for_each(size_t(base.height), [&](size_t y, int) {
+        Vec3d row(0.0);
+        for (size_t i = y * size_t(base.width), end = i + size_t(base.width); i < end; ++i) {
+            const Color c = image.texels[i] * scale;
+            base.texels[i] = {std::isfinite(c.x) ? std::max(c.x, 0.f) : 0.f,
+                              std::isfinite(c.y) ? std::max(c.y, 0.f) : 0.f,
+                              std::isfinite(c.z) ? std::max(c.z, 0.f) : 0.f};
+            row += Vec3d(base.texels[i]);
+        }
+        row_sums[y] = row;
+    });
     set_poles(base);
     m_texel_angle = float(std::max(kTwoPiD / base.width, kPiD / base.height));
-
-    // Solid-angle weighted mean radiance.
     Vec3d sum(0.0);
-    for (int y = 0; y < base.height; ++y) {
-        Vec3d row(0.0);
-        for (int x = 0; x < base.width; ++x) row += Vec3d(base.texels[size_t(y) * size_t(base.width) + size_t(x)]);
-        sum += row * texel_solid_angle(y, base.width, base.height);
-    }
+    for (int y = 0; y < base.height; ++y) sum += row_sums[size_t(y)] * texel_solid_angle(y, base.width, base.height);
     m_mean = Color(sum / (4.0 * kPiD));
 
     // split() reads level 0 alone: no pyramid, residual or prefilter for it.
@@ -473,22 +495,31 @@ EnvironmentMap::EnvironmentMap(const Environment& env, int threads, Use use, uin
     }
 
     // MIP pyramid down to 1 x 1.
-    m_levels = pyramid(std::move(base));
+    m_levels = pyramid(std::move(base), pool);
 
     // The residual the extracted lights leave, with its own pyramid only where some texel was extracted.
     m_threshold = env.extraction_threshold;
     const double threshold = m_threshold;
-    const std::vector<Color>& texels = m_levels.front().texels;
-    if (std::any_of(texels.begin(), texels.end(), [&](const Color& c) { return luminance(c) > threshold; })) {
-        Level residual = m_levels.front();
-        for (Color& c : residual.texels) c = residual_texel(c, luminance(c), threshold);
+    const Level& map = m_levels.front();
+    Level residual;
+    residual.width = map.width;
+    residual.height = map.height;
+    residual.texels.resize(map.texels.size());
+    std::vector<uint8_t> row_extracted(size_t(map.height), 0);
+    pool.for_each(size_t(map.height), [&](size_t y, int) {
+        for (size_t i = y * size_t(map.width), end = i + size_t(map.width); i < end; ++i) {
+            const double lum = luminance(map.texels[i]);
+            row_extracted[y] |= uint8_t(lum > threshold);
+            residual.texels[i] = residual_texel(map.texels[i], lum, threshold);
+        }
+    });
+    if (std::any_of(row_extracted.begin(), row_extracted.end(), [](uint8_t e) { return e != 0; })) {
         set_poles(residual);
-        m_residual = pyramid(std::move(residual));
+        m_residual = pyramid(std::move(residual), pool);
     }
 
     // The GGX prefilter of the map and of the residual.
     if ((levels & kAllPrefilterLevels) == 0) return;
-    WorkerPool pool(threads);
     m_prefiltered = prefilter(m_levels, levels, pool);
     if (!m_residual.empty()) m_residual_prefiltered = prefilter(m_residual, levels, pool);
 }
@@ -607,9 +638,15 @@ EnvironmentLighting EnvironmentMap::split(const SplitSettings& settings) const {
     // centroid carrying its power / pi (a Lambertian of albedo kd then receives kd (N.L) I).
     Vec3d extracted_power(0.0);
     const std::vector<Region> regions = extract ? median_cut(energy, w, h, settings.lights) : std::vector<Region>{};
-    for (const Region& r : regions) {
-        Vec3d power(0.0), centroid(0.0);
+    // Each region's power, energy centroid and solid angle, regions in parallel.
+    struct RegionSums {
+        Vec3d power{0.0}, centroid{0.0};
         double sr_total = 0;
+    };
+    std::vector<RegionSums> region_sums(regions.size());
+    pool.for_each(regions.size(), [&](size_t item, int) {
+        const Region& r = regions[item];
+        RegionSums& out_sums = region_sums[item];
         for (int y = r.y0; y < r.y1; ++y) {
             const double sr = grid.solid_angle(y);
             Vec3d row_power(0.0), row_centroid(0.0);
@@ -618,10 +655,14 @@ EnvironmentLighting EnvironmentMap::split(const SplitSettings& settings) const {
                 row_power += Vec3d(e);
                 row_centroid += grid.direction(x, y) * luminance(e);
             }
-            power += row_power * sr;
-            centroid += row_centroid * sr;
-            sr_total += sr * (r.x1 - r.x0);
+            out_sums.power += row_power * sr;
+            out_sums.centroid += row_centroid * sr;
+            out_sums.sr_total += sr * (r.x1 - r.x0);
         }
+    });
+    for (size_t item = 0; item < regions.size(); ++item) {
+        const Region& r = regions[item];
+        const auto& [power, centroid, sr_total] = region_sums[item];
         if (!(power.x > 0 || power.y > 0 || power.z > 0)) continue;
         ExtractedLight light;
         const Vec3d mid = grid.direction((r.x0 + r.x1) / 2, (r.y0 + r.y1) / 2);
