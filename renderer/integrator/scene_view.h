@@ -11,6 +11,7 @@
 #include "renderer/accel/accelerator.h"
 #include "renderer/scene/scene.h"
 #include "shading/environment_map.h"
+#include "shading/light_sample.h"
 #include "shading/material_mapping.h"
 #include "shading/scene_analysis.h"
 
@@ -77,6 +78,13 @@ public:
         return m_analysis.lights_of(object_index(m_scene, hit.geom, hit.inst));
     }
 
+    /// sample_light(scene().lights[light], p); a directional light's sample, the same at every
+    /// point, comes from a table made once.
+    LightSample sample_light(uint32_t light, const Vec3f& p) const {
+        return m_light_at_any_point[light] ? m_directional_samples[light]
+                                           : whitted::sample_light(m_scene.lights[light], p);
+    }
+
     // SurfaceFilter
     bool accept(const Ray& ray, const Hit& hit, RayKind kind) const override;
     Color transmittance(const Ray& ray, const Hit& hit) const override;
@@ -103,6 +111,8 @@ private:
                                       ///< world-space checker); 0 = surface() skips UVs and MIP levels
     SceneAnalysis m_analysis;
     std::shared_ptr<const EnvironmentMap> m_environment;  ///< built from scene.environment
+    std::vector<uint8_t> m_light_at_any_point;        ///< per light: directional (its sample below)
+    std::vector<LightSample> m_directional_samples;   ///< per light: sample_light() of a directional one
 };
 
 extern template SurfacePoint SceneView::surface<true>(const Ray&, const Hit&, const RayCone&) const;

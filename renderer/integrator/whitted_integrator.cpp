@@ -1,7 +1,9 @@
 #include "renderer/integrator/whitted_integrator.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <iterator>
 #include <utility>
 
@@ -125,8 +127,11 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         if constexpr (K.transmission) return e.potential * shadow;
         else return e.potential;
     };
-    auto add_light = [&](const Light& light) {
-        const LightSample ls = sample_light(light, s.sp.p);
+    // The extracted lights' highlight scale depends on the material alone: once per point.
+    const float environment_scale = environment_highlight_scale(c.n);
+    auto add_light = [&](uint32_t index) {
+        const Light& light = m_view.scene().lights[index];
+        const LightSample ls = m_view.sample_light(index, s.sp.p);
         if (is_black(ls.intensity)) {  // beyond its range window or outside its spot cone
             ++counters.shadow_skipped_unreached;
             return;
@@ -137,8 +142,7 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
             ++counters.shadow_skipped_facing;
             return;
         }
-        const Color term = local_term(c, s.f.N, ls.L, s.f.V, n_dot_l,
-                                      light.from_environment ? environment_highlight_scale(c.n) : 1.f);
+        const Color term = local_term(c, s.f.N, ls.L, s.f.V, n_dot_l, light.from_environment ? environment_scale : 1.f);
         if (is_black(term)) {  // kd = 0 and the highlight below its cutoff
             ++counters.shadow_skipped_zero;
             return;
@@ -155,32 +159,39 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         // Only the lights that can reach this object (SceneAnalysis light reach).
         const std::span<const uint32_t> reach = m_view.lights_reaching(s.hit);
         counters.shadow_skipped_unreached += m_view.scene().lights.size() - reach.size();
-        for (const uint32_t l : reach) add_light(m_view.scene().lights[l]);
+        for (const uint32_t l : reach) add_light(l);
     } else {
-        for (const Light& light : m_view.scene().lights) add_light(light);
+        for (uint32_t l = 0; l < uint32_t(m_view.scene().lights.size()); ++l) add_light(l);
     }
     if (environment.empty()) return sum;
 
-    // Brightest first; ties in light order, so the result does not depend on the sort.
-    std::sort(environment.begin(), environment.end(), [](const Candidate& a, const Candidate& b) {
-        return a.key != b.key ? a.key > b.key : a.light < b.light;
-    });
+    // Brightest first; ties in light order, so the result does not depend on the sort. The keys
+    // are not negative, so their bits order like their values: one integer per candidate, the
+    // key's bits inverted (brightest first) above its index (light order).
+    thread_local std::vector<uint64_t> order;
+    order.resize(environment.size());
+    for (size_t j = 0; j < environment.size(); ++j) {
+        const float key = environment[j].key > 0.f ? environment[j].key : 0.f;  // -0 and NaN as 0
+        order[j] = uint64_t(~std::bit_cast<uint32_t>(key)) << 32 | uint64_t(j);
+    }
+    std::sort(order.begin(), order.end());
+    auto nth = [&](size_t k) -> const Candidate& { return environment[uint32_t(order[k])]; };
     Color untested(0.f);
-    for (const Candidate& e : environment) untested += e.potential;
+    for (size_t k = 0; k < environment.size(); ++k) untested += nth(k).potential;
     Color tested(0.f), passed(0.f);
     size_t i = 0;
     for (; i < environment.size() && s.weight * max_component(untested) >= m_settings.min_weight; ++i) {
-        const Color through = shadowed(environment[i]);
+        const Color through = shadowed(nth(i));
         passed += through;
-        tested += environment[i].potential;
-        untested = untested - environment[i].potential;
+        tested += nth(i).potential;
+        untested = untested - nth(i).potential;
         untested = Color(std::max(untested.x, 0.f), std::max(untested.y, 0.f), std::max(untested.z, 0.f));
     }
     sum += passed;
     if (i == environment.size()) return sum;
     counters.shadow_skipped_dim += environment.size() - i;
     untested = Color(0.f);  // summed again: the running difference above is not exact
-    for (size_t j = i; j < environment.size(); ++j) untested += environment[j].potential;
+    for (size_t j = i; j < environment.size(); ++j) untested += nth(j).potential;
     if (i == 0) return sum + untested;  // all of them together below min_weight: unshadowed
     const Color let_through(tested.x > 0.f ? passed.x / tested.x : 1.f, tested.y > 0.f ? passed.y / tested.y : 1.f,
                             tested.z > 0.f ? passed.z / tested.z : 1.f);
