@@ -611,6 +611,11 @@ EnvironmentLighting EnvironmentMap::split(const SplitSettings& settings) const {
         const double sr = grid.solid_angle(y);
         RowSums& r = rows[row];
         if (extract) r.energy.resize(static_cast<size_t>(w));
+        // The sums in locals: stores to the energy row (doubles) would otherwise force every
+        // accumulator through memory on every texel.
+        std::array<Vec3d, 9> residual_sums{}, extracted_sums{};
+        Vec3d power(0.0);
+        double* const row_energy = extract ? r.energy.data() : nullptr;
         for (int x = 0; x < w; ++x) {
             const size_t i = size_t(y) * size_t(w) + size_t(x);
             const Color c = base.texels[i];
@@ -619,11 +624,14 @@ EnvironmentLighting EnvironmentMap::split(const SplitSettings& settings) const {
             const std::array<float, 9> basis = sh9_basis(world_from_map(Vec3f(grid.direction(x, y))));
             const Color extracted = extract && lum > threshold ? c - residual : Color(0.f);
             if (extract && lum > threshold)
-                for (size_t k = 0; k < 9; ++k) r.extracted[k] += Vec3d(extracted) * double(basis[k]);
-            if (extract) r.energy[size_t(x)] = luminance(extracted) * sr;
-            for (size_t k = 0; k < 9; ++k) r.residual[k] += Vec3d(residual) * double(basis[k]);
-            r.power += Vec3d(residual);
+                for (size_t k = 0; k < 9; ++k) extracted_sums[k] += Vec3d(extracted) * double(basis[k]);
+            if (extract) row_energy[x] = luminance(extracted) * sr;
+            for (size_t k = 0; k < 9; ++k) residual_sums[k] += Vec3d(residual) * double(basis[k]);
+            power += Vec3d(residual);
         }
+        r.residual = residual_sums;
+        r.extracted = extracted_sums;
+        r.power = power;
     });
     for (int y = 0; y < h; ++y) {
         const double sr = grid.solid_angle(y);
