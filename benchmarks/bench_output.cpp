@@ -135,9 +135,10 @@ void BM_WriteTiff16Level(benchmark::State& state) {
 }
 BENCHMARK(BM_WriteTiff16Level)->DenseRange(1, 9)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-void write_format(benchmark::State& state, const std::string& ext, bool half) {
+void write_format(benchmark::State& state, const std::string& ext, bool half, const std::string& tiff = "zip") {
     OutputSettings settings;
     settings.exr_half = half;
+    settings.tiff_compression = tiff;
     if (ext == ".tif8") settings.bits = 8;
     const fs::path file = scratch(ext == ".tif8" ? ".tif" : ext);
     for (auto _ : state) write_image(film(), file.string(), settings);
@@ -150,6 +151,10 @@ BENCHMARK_CAPTURE(write_format, exr_float, std::string(".exr"), false)->Unit(ben
 BENCHMARK_CAPTURE(write_format, jpeg, std::string(".jpg"), true)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(write_format, tiff16, std::string(".tif"), true)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(write_format, tiff8, std::string(".tif8"), true)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(write_format, tiff16_none, std::string(".tif"), true, std::string("none"))
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(write_format, tiff8_none, std::string(".tif8"), true, std::string("none"))
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

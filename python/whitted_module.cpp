@@ -260,9 +260,11 @@ py::dict info_dict(const PyScene& s) {
 }
 
 OutputSettings output_settings(const std::string& view, const std::string& display, const std::string& config,
-                               int bits, bool exr_float, const std::string& exr_compression) {
+                               int bits, bool exr_float, const std::string& exr_compression,
+                               const std::string& tiff_compression = "zip") {
     OutputSettings os;
     os.exr_compression = exr_compression;
+    os.tiff_compression = tiff_compression;
     os.color.view = view;
     os.color.display = display;
     os.color.config = config;
@@ -439,13 +441,15 @@ PYBIND11_MODULE(whitted, m) {
     m.def(
         "write",
         [](const PyImage& img, const std::string& path, const std::string& view, const std::string& display,
-           const std::string& config, int bits, bool exr_float, const std::string& exr_compression) {
+           const std::string& config, int bits, bool exr_float, const std::string& exr_compression,
+           const std::string& tiff_compression) {
             py::gil_scoped_release release;
-            write_image(*img.film, path, output_settings(view, display, config, bits, exr_float, exr_compression));
+            write_image(*img.film, path,
+                        output_settings(view, display, config, bits, exr_float, exr_compression, tiff_compression));
         },
         py::arg("image"), py::arg("path"), py::arg("view") = "Standard", py::arg("display") = "",
         py::arg("ocio_config") = "", py::arg("bits") = 0, py::arg("exr_float") = false,
-        py::arg("exr_compression") = "zip",
+        py::arg("exr_compression") = "zip", py::arg("tiff_compression") = "zip",
         "Writes the image as `render` does: .exr scene-linear with the AOVs, .png/.jpg/.tif through OCIO");
 
     m.def(

@@ -122,6 +122,20 @@ def test_write_exr_compression_keyword(glb, tmp_path):
         whitted.write(img, str(tmp_path / "bad.exr"), exr_compression="b44")
 
 
+def test_write_tiff_compression_keyword(glb, tmp_path):
+    img = whitted.render(glb, width=32, aa="center")
+    sizes = {}
+    for method in ("zip", "none", "zip:9"):
+        tif = tmp_path / f"{method.replace(':', '_')}.tif"
+        whitted.write(img, str(tif), tiff_compression=method)
+        assert np.array_equal(whitted.read_image(str(tif)), whitted.read_image(str(tmp_path / "zip.tif")))
+        sizes[method] = tif.stat().st_size
+    assert sizes["none"] > sizes["zip"]
+    with pytest.raises(whitted.Error, match="unknown TIFF compression 'lzw'"):
+        whitted.write(img, str(tmp_path / "bad.tif"), tiff_compression="lzw")
+    assert not (tmp_path / "bad.tif").exists()
+
+
 def test_ray_queries_agree_across_accelerators(glb):
     rng = np.random.default_rng(7)
     n = 20000

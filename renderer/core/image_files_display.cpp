@@ -2,12 +2,14 @@
 #include "renderer/core/image_files_display.h"
 
 #include <algorithm>
+#include <charconv>
 #include <csetjmp>
 #include <cstdarg>
 #include <memory>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <system_error>
 #include <vector>
 
 #include <fmt/format.h>
@@ -94,11 +96,45 @@ void write_jpeg_file(const std::string& path, const ImageDesc& desc, const void*
     if (!flushed) throw Error(fmt::format("cannot write '{}': {}", path, std::strerror(errno)));
 }
 
+namespace {
+
+/// The zlib level a TIFF compression name asks for: "none" -> 0, "zip" -> 1, "zip:N" -> N (1-12);
+/// anything else is an error message.
+std::string parse_tiff_compression(const std::string& name, int& level) {
+    if (name == "none") {
+        level = 0;
+        return {};
+    }
+    if (name == "zip") {
+        level = 1;
+        return {};
+    }
+    if (name.rfind("zip:", 0) == 0) {
+        const std::string digits = name.substr(4);
+        int n = 0;
+        const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), n);
+        if (ec == std::errc() && end == digits.data() + digits.size() && !digits.empty() && n >= 1 && n <= 12) {
+            level = n;
+            return {};
+        }
+        return fmt::format("TIFF compression '{}': the zlib level is 1 to 12", name);
+    }
+    return fmt::format("unknown TIFF compression '{}' (lossless: none, zip, zip:1 to zip:12)", name);
+}
+
+}  // namespace
+
+std::string tiff_compression_error(const std::string& name) {
+    int unused = 0;
+    return parse_tiff_compression(name, unused);
+}
+
 void write_tiff_file(const std::string& path, const ImageDesc& desc, const void* pixels, void (*before_pixels)()) {
     const int bits = checked_bits(desc, true);
     int level = 1;
-    if (const std::string c = desc.attribute("compression"); c.rfind("zip:", 0) == 0)
-        level = std::clamp(std::atoi(c.c_str() + 4), 1, 12);
+    if (const std::string name = desc.attribute("compression"); !name.empty())
+        if (const std::string why = parse_tiff_compression(name, level); !why.empty()) throw Error(why);
+    const bool deflate = level > 0;
     constexpr int kRowsPerStrip = 32;
     const size_t bytes_per_sample = size_t(bits / 8);
     const size_t row_bytes = size_t(desc.width) * 3 * bytes_per_sample;
@@ -106,9 +142,9 @@ void write_tiff_file(const std::string& path, const ImageDesc& desc, const void*
 
     // Each strip: the horizontal predictor (each sample minus the one of the pixel to its left,
     // modulo 2^bits, in native order as libtiff writes it) and its own zlib stream, on all cores.
-    std::vector<std::vector<uint8_t>> compressed(static_cast<size_t>(strips));
+    std::vector<std::vector<uint8_t>> compressed(static_cast<size_t>(deflate ? strips : 0));
     std::vector<char> failures(static_cast<size_t>(strips), 0);
-    tbb::parallel_for(0, strips, [&](int s) {
+    if (deflate) tbb::parallel_for(0, strips, [&](int s) {
         const int y0 = s * kRowsPerStrip, y1 = std::min(desc.height, y0 + kRowsPerStrip);
         std::vector<uint8_t> raw(size_t(y1 - y0) * row_bytes);
         for (int y = y0; y < y1; ++y) {
@@ -172,17 +208,23 @@ void write_tiff_file(const std::string& path, const ImageDesc& desc, const void*
     TIFFSetField(tif, TIFFTAG_PHOTOMETRIC, PHOTOMETRIC_RGB);
     TIFFSetField(tif, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
     TIFFSetField(tif, TIFFTAG_ORIENTATION, ORIENTATION_TOPLEFT);
-    TIFFSetField(tif, TIFFTAG_COMPRESSION, COMPRESSION_ADOBE_DEFLATE);
-    TIFFSetField(tif, TIFFTAG_PREDICTOR, PREDICTOR_HORIZONTAL);
+    TIFFSetField(tif, TIFFTAG_COMPRESSION, deflate ? COMPRESSION_ADOBE_DEFLATE : COMPRESSION_NONE);
+    if (deflate) TIFFSetField(tif, TIFFTAG_PREDICTOR, PREDICTOR_HORIZONTAL);
     TIFFSetField(tif, TIFFTAG_ROWSPERSTRIP, uint32_t(kRowsPerStrip));
     if (const std::string sw = desc.attribute("Software"); !sw.empty()) TIFFSetField(tif, TIFFTAG_SOFTWARE, sw.c_str());
     std::string description = desc.attribute("ImageDescription");
     if (const std::string others = other_attributes(desc, {"Software", "ImageDescription", "compression"}); !others.empty())
         description += (description.empty() ? "" : "\n") + others;
     if (!description.empty()) TIFFSetField(tif, TIFFTAG_IMAGEDESCRIPTION, description.c_str());
-    for (int s = 0; s < strips; ++s)
-        if (TIFFWriteRawStrip(tif, uint32_t(s), compressed[size_t(s)].data(), tmsize_t(compressed[size_t(s)].size())) < 0)
+    for (int s = 0; s < strips; ++s) {
+        // Uncompressed: the strip is the rows themselves.
+        const int rows = std::min(desc.height - s * kRowsPerStrip, kRowsPerStrip);
+        void* data = deflate ? static_cast<void*>(compressed[size_t(s)].data())
+                             : const_cast<uint8_t*>(static_cast<const uint8_t*>(pixels) + size_t(s) * kRowsPerStrip * row_bytes);
+        const auto size = tmsize_t(deflate ? compressed[size_t(s)].size() : size_t(rows) * row_bytes);
+        if (TIFFWriteRawStrip(tif, uint32_t(s), data, size) < 0)
             throw Error(fmt::format("cannot write '{}': {}", path, tiff_error.empty() ? "strip write failed" : tiff_error));
+    }
     if (!TIFFWriteDirectory(tif) || !tiff_error.empty())
         throw Error(fmt::format("cannot write '{}': {}", path, tiff_error.empty() ? "directory write failed" : tiff_error));
 }

@@ -14,10 +14,15 @@ namespace whitted {
 void write_jpeg_file(const std::string& path, const ImageDesc& desc, const void* pixels, void (*before_pixels)());
 
 /// As write_image_file with format_name "tiff": 8- or 16-bit RGB in strips of 32 rows, each
-/// a zlib stream (libdeflate level from "compression" = "zip:N", 1-12, default 1) of the rows with
-/// the horizontal predictor,
-/// strips compressed on all cores; "Software" and "ImageDescription" attributes become tags,
-/// the others join ImageDescription. The file's bytes do not depend on the thread count.
+/// a zlib stream (Adobe Deflate; libdeflate level from "compression" = "zip" (1) or "zip:N", 1-12,
+/// default 1) of the rows with the horizontal predictor, strips compressed on all cores; or, with
+/// "compression" = "none", the rows as they are. Another compression name throws
+/// (tiff_compression_error). "Software" and "ImageDescription" attributes become tags, the others
+/// join ImageDescription. The file's bytes do not depend on the thread count.
 void write_tiff_file(const std::string& path, const ImageDesc& desc, const void* pixels, void (*before_pixels)());
+
+/// Empty when `name` is a TIFF compression write_tiff_file takes (none, zip, zip:1 to zip:12),
+/// else why not (one line).
+std::string tiff_compression_error(const std::string& name);
 
 }  // namespace whitted

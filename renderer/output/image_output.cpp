@@ -36,6 +36,7 @@
 #include "renderer/core/data_files.h"
 #include "renderer/core/error.h"
 #include "renderer/core/image_files.h"
+#include "renderer/core/image_files_display.h"
 #include "renderer/core/image_files_exr.h"
 #include "renderer/core/log.h"
 #include "renderer/output/png_encoder.h"
@@ -382,8 +383,8 @@ EncodedImage encode_display(const Film& film, FileKind kind, const OutputSetting
         throw Error(fmt::format("{}: {}", path, e.what()));
     }
 
-    // Deflate level 1, chosen by measurement on 1920x1080 (docs/measurements/performance.md).
-    if (kind == FileKind::Tiff) desc.attributes.emplace_back("compression", "zip:1");
+    // zip = Deflate level 1, chosen by measurement on 1920x1080 (docs/measurements/performance.md).
+    if (kind == FileKind::Tiff) desc.attributes.emplace_back("compression", settings.tiff_compression);
     desc.attributes.emplace_back("whitted:display", transform->display());
     desc.attributes.emplace_back("whitted:view", transform->view());
     return image;
@@ -505,6 +506,9 @@ void write_image(const Film& film, const std::string& path, const OutputSettings
                                 file.extension().string(), kSupportedExtensions));
     if (*kind == FileKind::Exr)
         if (const std::string why = exr_compression_error(settings.exr_compression); !why.empty())
+            throw Error(fmt::format("{}: {}", path, why));
+    if (*kind == FileKind::Tiff)
+        if (const std::string why = tiff_compression_error(settings.tiff_compression); !why.empty())
             throw Error(fmt::format("{}: {}", path, why));
     validate_film(film, path);
 

@@ -138,6 +138,22 @@ TEST(Cli, ExrCompressionFlagWritesTheMethodAndRejectsOthers) {
     EXPECT_EQ(line_count(r.err), 1u) << r.err;
 }
 
+TEST(Cli, TiffCompressionFlagWritesTheMethodAndRejectsOthers) {
+    const fs::path none = fs::temp_directory_path() / "whitted_cli_tiff_none.tif";
+    const fs::path zip = fs::temp_directory_path() / "whitted_cli_tiff_zip.tif";
+    Result r = run("render '" + kBox + "' --width 32 --aa center --no-progress --tiff-compression none -o '" +
+                   none.string() + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = run("render '" + kBox + "' --width 32 --aa center --no-progress -o '" + zip.string() + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(whitted::test::read_pixels(none), whitted::test::read_pixels(zip));  // lossless both ways
+    EXPECT_GT(fs::file_size(none), fs::file_size(zip));
+    r = run("render '" + kBox + "' --width 32 --no-progress --tiff-compression lzw -o /tmp/whitted_cli_tiff_bad.tif");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("unknown TIFF compression 'lzw'"), std::string::npos) << r.err;
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+}
+
 TEST(Cli, UnknownOutputExtensionIsAnErrorAndWritesNothing) {
     const fs::path out = fs::temp_directory_path() / "whitted_cli_out.xyz";
     fs::remove(out);

@@ -21,6 +21,7 @@
 
 #include "renderer/core/error.h"
 #include "renderer/core/image_files.h"
+#include "renderer/core/image_files_display.h"
 #include "renderer/output/image_output.h"
 #include "renderer/output/png_encoder.h"
 
@@ -166,25 +167,53 @@ TEST(PngEncoder, WriteImageStoresExactlyTheDisplayCodes) {
 }
 
 TEST(TiffWriter, StoresExactlyTheDisplayCodesForAnySize) {
-    // Heights that leave a partial strip (strips of 32 rows), one-pixel-wide images, 8 and 16 bits.
+    // Heights that leave a partial strip (strips of 32 rows), one-pixel-wide images, 8 and 16 bits,
+    // Deflate (the default, and level 9) and uncompressed strips (--tiff-compression).
     for (auto [w, h] : {std::pair{97, 61}, std::pair{1, 33}, std::pair{40, 32}, std::pair{3, 1}}) {
         const Film film = random_film(w, h, uint32_t(w * 1000 + h));
-        for (int bits : {8, 16}) {
-            OutputSettings settings;
-            settings.bits = bits;
-            settings.metadata["whitted:test"] = "yes";
-            const fs::path file = temp_file(fmt::format("film{}x{}_{}.tif", w, h, bits));
-            write_image(film, file.string(), settings);
-            std::vector<uint8_t> expected(size_t(w) * size_t(h) * 3 * (bits == 16 ? 2 : 1));
-            display_codes(film.beauty, DisplayTransform(settings.color), bits, expected);
-            const Decoded d = decode(file, bits);
-            EXPECT_EQ(d.spec.format, bits == 16 ? OIIO::TypeUInt16 : OIIO::TypeUInt8);
-            EXPECT_TRUE(d.codes == expected) << w << "x" << h << " at " << bits << " bits";
-            EXPECT_EQ(d.spec.get_string_attribute("Software"), "whitted " WHITTED_VERSION);
-            EXPECT_NE(d.spec.get_string_attribute("ImageDescription").find("whitted:test: yes"), std::string::npos);
-            fs::remove(file);
-        }
+        for (int bits : {8, 16})
+            for (const char* compression : {"zip", "zip:9", "none"}) {
+                OutputSettings settings;
+                settings.bits = bits;
+                settings.tiff_compression = compression;
+                settings.metadata["whitted:test"] = "yes";
+                const fs::path file = temp_file(fmt::format("film{}x{}_{}.tif", w, h, bits));
+                write_image(film, file.string(), settings);
+                std::vector<uint8_t> expected(size_t(w) * size_t(h) * 3 * (bits == 16 ? 2 : 1));
+                display_codes(film.beauty, DisplayTransform(settings.color), bits, expected);
+                const Decoded d = decode(file, bits);
+                const std::string what = fmt::format("{}x{} at {} bits, {}", w, h, bits, compression);
+                EXPECT_EQ(d.spec.format, bits == 16 ? OIIO::TypeUInt16 : OIIO::TypeUInt8) << what;
+                EXPECT_TRUE(d.codes == expected) << what;
+                EXPECT_EQ(d.spec.get_string_attribute("compression"), compression == std::string("none") ? "none" : "zip")
+                    << what;
+                EXPECT_EQ(d.spec.get_string_attribute("Software"), "whitted " WHITTED_VERSION);
+                EXPECT_NE(d.spec.get_string_attribute("ImageDescription").find("whitted:test: yes"), std::string::npos);
+                fs::remove(file);
+            }
     }
+}
+
+// --tiff-compression: a name the flag does not take is one error naming the file, and writes
+// nothing (it used to be that any compression attribute but zip:N meant level 1).
+TEST(TiffWriter, UnknownCompressionIsAnErrorAndWritesNothing) {
+    const Film film = random_film(8, 8, 3);
+    for (const char* bad : {"zip:0", "zip:13", "zip:", "zip:x", "lzw", "deflate", "ZIP", ""}) {
+        OutputSettings settings;
+        settings.tiff_compression = bad;
+        const fs::path file = temp_file("bad_compression.tif");
+        fs::remove(file);
+        try {
+            write_image(film, file.string(), settings);
+            ADD_FAILURE() << "'" << bad << "' accepted";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("bad_compression.tif: "), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("TIFF compression"), std::string::npos) << e.what();
+        }
+        EXPECT_FALSE(fs::exists(file)) << bad;
+    }
+    EXPECT_EQ(tiff_compression_error("none"), "");
+    EXPECT_EQ(tiff_compression_error("zip:12"), "");
 }
 
 TEST(TiffWriter, BytesDoNotDependOnTheThreadCount) {
