@@ -1282,15 +1282,31 @@ private:
                                   file_loc(m_path, fmt::format("/images/{}", i)), label);
     }
 
+    /// Each image decoded once, the images in parallel; then each texture's MIP chain, the
+    /// textures in parallel. A bad image is reported as the serial loop would: the first one in
+    /// the textures' order.
     void decode_textures() {
         if (!m_options.load_textures) return;
-        std::unordered_map<int, MipLevel> images;  // each image decoded once
-        for (Texture& t : m_scene.textures) {
-            auto it = images.find(t.image);
-            if (it == images.end()) it = images.emplace(t.image, decode_image(t.image)).first;
-            t.levels.assign(1, it->second);
+        std::vector<int> unique;  // images in the order the textures first use them
+        std::unordered_map<int, size_t> slot;
+        for (const Texture& t : m_scene.textures)
+            if (slot.emplace(t.image, unique.size()).second) unique.push_back(t.image);
+        std::vector<MipLevel> images(unique.size());
+        std::vector<std::exception_ptr> failed(unique.size());
+        tbb::parallel_for(size_t(0), unique.size(), [&](size_t u) {
+            try {
+                images[u] = decode_image(unique[u]);
+            } catch (...) {
+                failed[u] = std::current_exception();
+            }
+        });
+        for (const std::exception_ptr& e : failed)
+            if (e) std::rethrow_exception(e);
+        tbb::parallel_for(size_t(0), m_scene.textures.size(), [&](size_t i) {
+            Texture& t = m_scene.textures[i];
+            t.levels.assign(1, images[slot.at(t.image)]);
             if (t.use_mips) build_mip_levels(t);
-        }
+        });
     }
 
     // ---- defaults -----------------------------------------------------------------------------

@@ -8,9 +8,13 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
+
+#include <tbb/parallel_for.h>
 
 #include "renderer/core/error.h"
 
@@ -161,17 +165,32 @@ std::vector<Rgba> reduce_level(int src_w, int src_h, int dst_w, int dst_h, Fetch
     for (int y = 0; y < dst_h; ++y) taps_y[size_t(y)] = box_taps(y, src_h, dst_h);
 
     std::vector<Rgba> dst(size_t(dst_w) * size_t(dst_h));
-    for (int y = 0; y < dst_h; ++y) {
+    // Rows on all cores (each texel on its own: the same values for any split).
+    tbb::parallel_for(0, dst_h, [&](int y) {
         const Taps& ty = taps_y[size_t(y)];
+        Rgba* out = dst.data() + size_t(y) * size_t(dst_w);
+        if (src_w == 2 * dst_w && src_h == 2 * dst_h) {
+            // Even sizes: the plain 2x2 box, the general loop's operations in its order (weights
+            // 1/2 x 1/2), without its tap bookkeeping.
+            for (int x = 0; x < dst_w; ++x) {
+                Rgba sum;
+                sum.add(fetch_src(2 * x, 2 * y), 0.25f);
+                sum.add(fetch_src(2 * x + 1, 2 * y), 0.25f);
+                sum.add(fetch_src(2 * x, 2 * y + 1), 0.25f);
+                sum.add(fetch_src(2 * x + 1, 2 * y + 1), 0.25f);
+                out[x] = sum;
+            }
+            return;
+        }
         for (int x = 0; x < dst_w; ++x) {
             const Taps& tx = taps_x[size_t(x)];
             Rgba sum;
             for (int j = 0; j < ty.count; ++j)
                 for (int i = 0; i < tx.count; ++i)
                     sum.add(fetch_src(tx.first + i, ty.first + j), tx.weight[size_t(i)] * ty.weight[size_t(j)]);
-            dst[size_t(y) * size_t(dst_w) + size_t(x)] = sum;
+            out[x] = sum;
         }
-    }
+    });
     return dst;
 }
 
@@ -179,12 +198,59 @@ std::vector<Rgba> reduce_level(int src_w, int src_h, int dst_w, int dst_h, Fetch
 
 float srgb8_to_linear(uint8_t v) { return srgb_table()[v]; }
 
-uint8_t linear_to_srgb8(float v) {
+uint8_t linear_to_srgb8_formula(float v) {
     if (!(v > 0.f)) return 0;
     if (v >= 1.f) return 255;
     const double l = v;
     const double s = l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055;
     return uint8_t(std::lround(std::clamp(s, 0.0, 1.0) * 255.0));
+}
+
+namespace {
+
+/// linear_to_srgb8_formula's codes by table. threshold[k - 1] holds the bits of the smallest float
+/// whose code is at least k (k = 1..255; threshold[255] is a sentinel above every input). Positive
+/// floats order like their bits, and the formula never decreases, so each is found by bisection on
+/// the bits with the formula itself; a value's code is the number of thresholds at or below it.
+/// first_code[b] is that number at the start of bucket b (the bits' top 16: 128 buckets per
+/// octave), so a lookup steps past at most a threshold or two. The formula's own codes:
+/// tests/unit/test_texture_sampling.cpp compares them over a dense sweep.
+struct SrgbEncodeTable {
+    std::array<uint32_t, 256> threshold{};
+    std::vector<uint8_t> first_code;
+
+    SrgbEncodeTable() {
+        const uint32_t one = std::bit_cast<uint32_t>(1.f);
+        for (uint32_t k = 1; k <= 255; ++k) {
+            uint32_t lo = k == 1 ? 0u : threshold[k - 2], hi = one;  // code(lo) < k <= code(hi) = 255
+            while (hi - lo > 1) {
+                const uint32_t mid = lo + (hi - lo) / 2;
+                (linear_to_srgb8_formula(std::bit_cast<float>(mid)) >= k ? hi : lo) = mid;
+            }
+            threshold[k - 1] = hi;
+        }
+        threshold[255] = std::numeric_limits<uint32_t>::max();
+        first_code.resize((one >> 16) + 1);
+        for (size_t b = 0; b < first_code.size(); ++b)
+            first_code[b] = uint8_t(std::upper_bound(threshold.begin(), threshold.begin() + 255, uint32_t(b) << 16) -
+                                    threshold.begin());
+    }
+
+    uint8_t code(float v) const {  // v in (0, 1)
+        const uint32_t bits = std::bit_cast<uint32_t>(v);
+        uint32_t k = first_code[bits >> 16];
+        while (threshold[k] <= bits) ++k;
+        return uint8_t(k);
+    }
+};
+
+}  // namespace
+
+uint8_t linear_to_srgb8(float v) {
+    static const SrgbEncodeTable table;
+    if (!(v > 0.f)) return 0;
+    if (v >= 1.f) return 255;
+    return table.code(v);
 }
 
 Vec2f apply_texture_transform(const TextureTransform& xf, Vec2f uv) {

@@ -42,6 +42,11 @@ void build_mip_levels(Texture& texture);
 float srgb8_to_linear(uint8_t v);
 
 /// Linear -> sRGB transfer, rounded to the nearest 8-bit code; input clamped to [0, 1], NaN -> 0.
+/// Looked up among the 255 code thresholds of linear_to_srgb8_formula (the same codes, without a
+/// pow per value: MIP levels of sRGB textures encode every texel).
 uint8_t linear_to_srgb8(float v);
+
+/// The definition linear_to_srgb8 follows: the IEC 61966-2-1 curve in double, rounded.
+uint8_t linear_to_srgb8_formula(float v);
 
 }  // namespace whitted

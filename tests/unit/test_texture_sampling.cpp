@@ -1,5 +1,6 @@
 // Texture lookups: wrap modes, filtering, sRGB decoding, MIP chains, KHR_texture_transform.
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -62,6 +63,39 @@ TEST(TextureSampling, SrgbEncodeRoundTrips) {
     EXPECT_EQ(linear_to_srgb8(-1.f), 0);
     EXPECT_EQ(linear_to_srgb8(7.f), 255);
     EXPECT_EQ(linear_to_srgb8(std::nanf("")), 0);
+}
+
+// The threshold lookup gives the formula's codes: a sweep of every 61st float from 0 to 1 (17.5
+// million values), every float within 4096 ulps of each point where the sweep sees the code
+// change (found again here by bisection between the two sweep points), and the ends.
+TEST(TextureSampling, SrgbEncodeTableIsTheFormula) {
+    auto same = [](uint32_t bits) {
+        const float v = std::bit_cast<float>(bits);
+        return linear_to_srgb8(v) == linear_to_srgb8_formula(v);
+    };
+    const uint32_t one = std::bit_cast<uint32_t>(1.f);
+    int changes = 0;
+    uint32_t prev = 0;
+    uint8_t prev_code = 0;
+    for (uint32_t bits = 61; bits <= one; bits += 61) {
+        ASSERT_TRUE(same(bits)) << std::bit_cast<float>(bits);
+        const uint8_t code = linear_to_srgb8_formula(std::bit_cast<float>(bits));
+        if (code != prev_code) {
+            uint32_t lo = prev, hi = bits;  // code(lo) < code(hi): the first change lies in (lo, hi]
+            while (hi - lo > 1) {
+                const uint32_t mid = lo + (hi - lo) / 2;
+                (linear_to_srgb8_formula(std::bit_cast<float>(mid)) != prev_code ? hi : lo) = mid;
+            }
+            for (uint32_t b = hi - std::min(hi, 4096u); b < hi + 4096u; ++b) ASSERT_TRUE(same(b)) << std::bit_cast<float>(b);
+            ++changes;
+        }
+        prev = bits;
+        prev_code = code;
+    }
+    EXPECT_EQ(changes, 255);  // every code from 1 to 255 begins somewhere in (0, 1]
+    for (float v : {0.f, -0.f, 1e-45f, 1.f, std::nextafter(1.f, 0.f), 2.f, -1.f, std::nanf(""),
+                    std::numeric_limits<float>::infinity()})
+        EXPECT_EQ(linear_to_srgb8(v), linear_to_srgb8_formula(v)) << v;
 }
 
 // ---- wrap modes (nearest, exact texel values) ------------------------------------------------
