@@ -1173,6 +1173,23 @@ TEST(GltfHandMade, UndecodableImageIsAnError) {
     EXPECT_NO_THROW(load_scene(path, no_textures()));
 }
 
+// Images are decoded in parallel; with two bad ones the error is still the one the textures'
+// order meets first (the base color texture, whose image is the second), every time.
+TEST(GltfHandMade, FirstUndecodableImageInTextureOrderIsTheError) {
+    std::string json = edit(kQuadJson, R"("scene": 0)",
+                            R"("scene": 0, "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0},
+            "metallicRoughnessTexture": {"index": 1}}}],
+        "textures": [{"source": 1}, {"source": 0}], "images": [{"uri": "first.png"}, {"uri": "second.png"}])");
+    json = edit(json, R"("attributes": {"POSITION": 0})", R"("attributes": {"POSITION": 0}, "material": 0)");
+    const std::string path = write_gltf("two_bad_images.gltf", json, quad_bin());
+    write_file("first.png", std::string("not a png either"));
+    write_file("second.png", std::string("this is not a png"));
+    for (int i = 0; i < 20; ++i) {
+        const std::string err = error_text([&] { load_scene(path); });
+        ASSERT_NE(err.find("/images/1: cannot decode image 'second.png'"), std::string::npos) << i << ": " << err;
+    }
+}
+
 TEST(GltfHandMade, MissingImageIsAnErrorEvenWithoutDecoding) {
     std::string json = edit(kQuadJson, R"("scene": 0)", R"("scene": 0, "images": [{"uri": "nowhere.png"}])");
     const std::string path = write_gltf("missing_image.gltf", json, quad_bin());
