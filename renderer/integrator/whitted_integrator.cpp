@@ -127,8 +127,9 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         if constexpr (K.transmission) return e.potential * shadow;
         else return e.potential;
     };
-    // The extracted lights' highlight scale depends on the material alone: once per point.
-    const float environment_scale = environment_highlight_scale(c.n);
+    // The extracted lights' highlight scale depends on the material alone: once per point where
+    // there are such lights (an environment), instead of once per light.
+    const float environment_scale = m_view.environment() ? environment_highlight_scale(c.n) : 1.f;
     auto add_light = [&](uint32_t index) {
         const Light& light = m_view.scene().lights[index];
         const LightSample ls = m_view.sample_light(index, s.sp.p);
