@@ -1291,9 +1291,14 @@ private:
         std::unordered_map<int, size_t> slot;
         for (const Texture& t : m_scene.textures)
             if (slot.emplace(t.image, unique.size()).second) unique.push_back(t.image);
+        // One item: no threads (they cost more than they save on a small file).
+        auto for_each = [](size_t n, const auto& body) {
+            if (n > 1) tbb::parallel_for(size_t(0), n, body);
+            else if (n == 1) body(size_t(0));
+        };
         std::vector<MipLevel> images(unique.size());
         std::vector<std::exception_ptr> failed(unique.size());
-        tbb::parallel_for(size_t(0), unique.size(), [&](size_t u) {
+        for_each(unique.size(), [&](size_t u) {
             try {
                 images[u] = decode_image(unique[u]);
             } catch (...) {
@@ -1302,7 +1307,7 @@ private:
         });
         for (const std::exception_ptr& e : failed)
             if (e) std::rethrow_exception(e);
-        tbb::parallel_for(size_t(0), m_scene.textures.size(), [&](size_t i) {
+        for_each(m_scene.textures.size(), [&](size_t i) {
             Texture& t = m_scene.textures[i];
             t.levels.assign(1, images[slot.at(t.image)]);
             if (t.use_mips) build_mip_levels(t);

@@ -14,8 +14,6 @@
 #include <limits>
 #include <vector>
 
-#include <tbb/parallel_for.h>
-
 #include "renderer/core/error.h"
 
 namespace whitted {
@@ -165,8 +163,8 @@ std::vector<Rgba> reduce_level(int src_w, int src_h, int dst_w, int dst_h, Fetch
     for (int y = 0; y < dst_h; ++y) taps_y[size_t(y)] = box_taps(y, src_h, dst_h);
 
     std::vector<Rgba> dst(size_t(dst_w) * size_t(dst_h));
-    // Rows on all cores (each texel on its own: the same values for any split).
-    tbb::parallel_for(0, dst_h, [&](int y) {
+    // One thread: the importer builds the textures' chains in parallel, one texture per task.
+    for (int y = 0; y < dst_h; ++y) {
         const Taps& ty = taps_y[size_t(y)];
         Rgba* out = dst.data() + size_t(y) * size_t(dst_w);
         if (src_w == 2 * dst_w && src_h == 2 * dst_h) {
@@ -180,7 +178,7 @@ std::vector<Rgba> reduce_level(int src_w, int src_h, int dst_w, int dst_h, Fetch
                 sum.add(fetch_src(2 * x + 1, 2 * y + 1), 0.25f);
                 out[x] = sum;
             }
-            return;
+            continue;
         }
         for (int x = 0; x < dst_w; ++x) {
             const Taps& tx = taps_x[size_t(x)];
@@ -190,7 +188,7 @@ std::vector<Rgba> reduce_level(int src_w, int src_h, int dst_w, int dst_h, Fetch
                     sum.add(fetch_src(tx.first + i, ty.first + j), tx.weight[size_t(i)] * ty.weight[size_t(j)]);
             out[x] = sum;
         }
-    });
+    }
     return dst;
 }
 
