@@ -1173,8 +1173,9 @@ TEST(GltfHandMade, UndecodableImageIsAnError) {
     EXPECT_NO_THROW(load_scene(path, no_textures()));
 }
 
-// Images are decoded in parallel; with two bad ones the error is still the one the textures'
-// order meets first (the base color texture, whose image is the second), every time.
+// Images are decoded in parallel (when there is enough to decode: these two are 200 KB each);
+// with two bad ones the error is still the one the textures' order meets first (the base color
+// texture, whose image is the second), every time.
 TEST(GltfHandMade, FirstUndecodableImageInTextureOrderIsTheError) {
     std::string json = edit(kQuadJson, R"("scene": 0)",
                             R"("scene": 0, "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0},
@@ -1182,8 +1183,8 @@ TEST(GltfHandMade, FirstUndecodableImageInTextureOrderIsTheError) {
         "textures": [{"source": 1}, {"source": 0}], "images": [{"uri": "first.png"}, {"uri": "second.png"}])");
     json = edit(json, R"("attributes": {"POSITION": 0})", R"("attributes": {"POSITION": 0}, "material": 0)");
     const std::string path = write_gltf("two_bad_images.gltf", json, quad_bin());
-    write_file("first.png", std::string("not a png either"));
-    write_file("second.png", std::string("this is not a png"));
+    write_file("first.png", "not a png either" + std::string(200000, 'x'));
+    write_file("second.png", "this is not a png" + std::string(200000, 'y'));
     for (int i = 0; i < 20; ++i) {
         const std::string err = error_text([&] { load_scene(path); });
         ASSERT_NE(err.find("/images/1: cannot decode image 'second.png'"), std::string::npos) << i << ": " << err;
