@@ -504,9 +504,9 @@ EnvironmentMap::EnvironmentMap(const Environment& env, int threads, Use use, uin
     Level residual;
     residual.width = map.width;
     residual.height = map.height;
-    residual.texels.resize(map.texels.size());
     std::vector<uint8_t> row_extracted(size_t(map.height), 0);
-    pool.for_each(size_t(map.height), [&](size_t y, int) {
+    if (threshold < kInfinity) residual.texels.resize(map.texels.size());  // else nothing was extracted
+    if (threshold < kInfinity) pool.for_each(size_t(map.height), [&](size_t y, int) {
         for (size_t i = y * size_t(map.width), end = i + size_t(map.width); i < end; ++i) {
             const double lum = luminance(map.texels[i]);
             row_extracted[y] |= uint8_t(lum > threshold);
