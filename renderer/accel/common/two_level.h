@@ -30,8 +30,6 @@
 //   size_t bytes() const; size_t nodes() const.
 #pragma once
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <chrono>
 #include <functional>
@@ -47,6 +45,7 @@
 #include "renderer/accel/common/primitives.h"
 #include "renderer/accel/common/queries.h"
 #include "renderer/accel/common/simd.h"
+#include "renderer/core/parallel.h"
 #include "renderer/scene/scene.h"
 
 namespace whitted {
@@ -164,9 +163,11 @@ public:
         std::vector<uint8_t> mesh_flat(scene.meshes.size(), 0);
         for (size_t i = 0; i < flat.size(); ++i)
             if (flat[i]) mesh_flat[scene.instances[i].mesh] = 1;
-        // Bottom level: one structure per instanced mesh that has triangles, and the flat one.
+        // Bottom level: one structure per instanced mesh that has triangles, and the flat one,
+        // meshes in parallel on the worker pool (whose fork and join ThreadSanitizer sees, and
+        // whose workers build in the same floating-point mode as the caller).
         m_blas.resize(scene.meshes.size());
-        tbb::parallel_for(size_t(0), scene.meshes.size(), [&](size_t m) {
+        WorkerPool(0).for_each(scene.meshes.size(), [&](size_t m, int) {
             if (scene.meshes[m].triangle_count() > 0 && !mesh_flat[m])
                 m_blas[m] = std::make_unique<Blas>(build_blas(scene.meshes[m]));
         });
