@@ -261,7 +261,7 @@ py::dict info_dict(const PyScene& s) {
 
 OutputSettings output_settings(const std::string& view, const std::string& display, const std::string& config,
                                int bits, bool exr_float, const std::string& exr_compression,
-                               const std::string& tiff_compression = "zip") {
+                               const std::string& tiff_compression) {
     OutputSettings os;
     os.exr_compression = exr_compression;
     os.tiff_compression = tiff_compression;

@@ -497,25 +497,28 @@ EnvironmentMap::EnvironmentMap(const Environment& env, int threads, Use use, uin
     // MIP pyramid down to 1 x 1.
     m_levels = pyramid(std::move(base), pool);
 
-    // The residual the extracted lights leave, with its own pyramid only where some texel was extracted.
+    // The residual the extracted lights leave, with its own pyramid only where some texel was
+    // extracted (none under an infinite threshold).
     m_threshold = env.extraction_threshold;
     const double threshold = m_threshold;
-    const Level& map = m_levels.front();
-    Level residual;
-    residual.width = map.width;
-    residual.height = map.height;
-    std::vector<uint8_t> row_extracted(size_t(map.height), 0);
-    if (threshold < kInfinity) residual.texels.resize(map.texels.size());  // else nothing was extracted
-    if (threshold < kInfinity) pool.for_each(size_t(map.height), [&](size_t y, int) {
-        for (size_t i = y * size_t(map.width), end = i + size_t(map.width); i < end; ++i) {
-            const double lum = luminance(map.texels[i]);
-            row_extracted[y] |= uint8_t(lum > threshold);
-            residual.texels[i] = residual_texel(map.texels[i], lum, threshold);
+    if (threshold < kInfinity) {
+        const Level& map = m_levels.front();
+        Level residual;
+        residual.width = map.width;
+        residual.height = map.height;
+        residual.texels.resize(map.texels.size());
+        std::vector<uint8_t> row_extracted(size_t(map.height), 0);
+        pool.for_each(size_t(map.height), [&](size_t y, int) {
+            for (size_t i = y * size_t(map.width), end = i + size_t(map.width); i < end; ++i) {
+                const double lum = luminance(map.texels[i]);
+                row_extracted[y] |= uint8_t(lum > threshold);
+                residual.texels[i] = residual_texel(map.texels[i], lum, threshold);
+            }
+        });
+        if (std::any_of(row_extracted.begin(), row_extracted.end(), [](uint8_t e) { return e != 0; })) {
+            set_poles(residual);
+            m_residual = pyramid(std::move(residual), pool);
         }
-    });
-    if (std::any_of(row_extracted.begin(), row_extracted.end(), [](uint8_t e) { return e != 0; })) {
-        set_poles(residual);
-        m_residual = pyramid(std::move(residual), pool);
     }
 
     // The GGX prefilter of the map and of the residual.

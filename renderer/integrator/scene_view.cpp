@@ -73,13 +73,10 @@ SceneView::SceneView(const Scene& scene, const MappingOptions& mapping)
     if (scene.environment)
         m_environment = std::make_shared<const EnvironmentMap>(*scene.environment, 0, EnvironmentMap::Use::Rendering,
                                                                m_analysis.prefilter_levels);
-    m_light_at_any_point.resize(scene.lights.size());
     m_directional_samples.resize(scene.lights.size());
     for (size_t i = 0; i < scene.lights.size(); ++i)
-        if (scene.lights[i].type == LightType::Directional) {
-            m_light_at_any_point[i] = 1;
+        if (scene.lights[i].type == LightType::Directional)
             m_directional_samples[i] = whitted::sample_light(scene.lights[i], Vec3f(0.f));
-        }
     // Float transforms per instance; the normal matrix is inverted in double precision.
     m_xf.resize(scene.instances.size());
     for (size_t i = 0; i < scene.instances.size(); ++i) {

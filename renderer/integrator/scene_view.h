@@ -81,8 +81,8 @@ public:
     /// sample_light(scene().lights[light], p); a directional light's sample, the same at every
     /// point, comes from a table made once.
     LightSample sample_light(uint32_t light, const Vec3f& p) const {
-        return m_light_at_any_point[light] ? m_directional_samples[light]
-                                           : whitted::sample_light(m_scene.lights[light], p);
+        const Light& l = m_scene.lights[light];
+        return l.type == LightType::Directional ? m_directional_samples[light] : whitted::sample_light(l, p);
     }
 
     // SurfaceFilter
@@ -111,8 +111,7 @@ private:
                                       ///< world-space checker); 0 = surface() skips UVs and MIP levels
     SceneAnalysis m_analysis;
     std::shared_ptr<const EnvironmentMap> m_environment;  ///< built from scene.environment
-    std::vector<uint8_t> m_light_at_any_point;        ///< per light: directional (its sample below)
-    std::vector<LightSample> m_directional_samples;   ///< per light: sample_light() of a directional one
+    std::vector<LightSample> m_directional_samples;  ///< per light: sample_light() of a directional one
 };
 
 extern template SurfacePoint SceneView::surface<true>(const Ray&, const Hit&, const RayCone&) const;

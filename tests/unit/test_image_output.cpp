@@ -326,7 +326,6 @@ Film make_aov_film() {
 // nothing.
 TEST_F(ImageOutputTest, ExrCompressionsAreLosslessAndNamedInTheHeader) {
     const Film film = make_aov_film();
-    std::vector<float> first;
     for (const char* method : {"none", "rle", "zips", "zips:9", "zip", "zip:6", "piz"}) {
         OutputSettings settings;
         settings.exr_half = false;
