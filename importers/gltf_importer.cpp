@@ -1282,9 +1282,9 @@ private:
                                   file_loc(m_path, fmt::format("/images/{}", i)), label);
     }
 
-    /// Each image decoded once, the images in parallel; then each texture's MIP chain, the
-    /// textures in parallel. A bad image is reported as the serial loop would: the first one in
-    /// the textures' order.
+    /// Each image decoded once; then each texture's MIP chain. Both in parallel (images, textures)
+    /// when there is enough work to share. A bad image is reported as the serial loop would: the
+    /// first one in the textures' order.
     void decode_textures() {
         if (!m_options.load_textures) return;
         std::vector<int> unique;  // images in the order the textures first use them

@@ -60,8 +60,9 @@ struct OutputSettings {
     int bits = 0;                         ///< 8 or 16 for PNG/TIFF; 0 = 8 (PNG/JPEG), 16 (TIFF)
     bool exr_half = true;                 ///< EXR beauty as half (true) or float (false)
     /// EXR compression, all lossless: none, rle, zips, zip, piz; zip and zips take a zlib level,
-    /// "zip:6" (default 1); exr_compression_error (renderer/core/image_files_exr.h) checks it. "zip" by default; "none" writes a float beauty about 3x faster at 3x the
-    /// bytes (docs/performance.md, "Output").
+    /// "zip:6" (default 1); exr_compression_error (renderer/core/image_files_exr.h) checks it.
+    /// "zip" by default; "none" writes a float beauty about 3x faster at 3x the bytes
+    /// (docs/performance.md, "Output").
     std::string exr_compression = "zip";
     /// TIFF compression, lossless: zip (Deflate with the horizontal predictor, level 1; zip:N for
     /// 1-12) or none; tiff_compression_error (renderer/core/image_files_display.h) checks it. "none"
