@@ -30,11 +30,11 @@
 #include "benchmarks/bench_timing.h"
 #include "benchmarks/ray_recording.h"
 #include "importers/scene_loader.h"
-#include "renderer/core/error.h"
-#include "renderer/core/log.h"
-#include "renderer/integrator/camera.h"
-#include "renderer/integrator/render.h"
-#include "renderer/output/image_output.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "integrator/camera.h"
+#include "integrator/render.h"
+#include "output/image_output.h"
 
 namespace whitted::app {
 

@@ -42,11 +42,12 @@
 #include "benchmarks/ray_recording.h"
 #include "importers/mesh_normals.h"
 #include "importers/scene_loader.h"
-#include "renderer/accel/accelerator.h"
-#include "renderer/core/error.h"
-#include "renderer/core/log.h"
-#include "renderer/integrator/render.h"
-#include "renderer/scene/scene.h"
+#include "accel/accelerator.h"
+#include "accel/factory/create_accelerator.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "integrator/render.h"
+#include "scene/scene.h"
 
 namespace whitted::app {
 

@@ -6,8 +6,9 @@
 #include <random>
 #include <vector>
 
-#include "renderer/accel/accelerator.h"
-#include "renderer/scene/scene.h"
+#include "accel/accelerator.h"
+#include "accel/factory/create_accelerator.h"
+#include "scene/scene.h"
 
 namespace {
 

@@ -14,14 +14,22 @@
 // bundled scene rendered with the first map and 0 extracted lights against a plain background
 // (no environment), both with the same lights, as a ratio of median times.
 //
-// Writes <out>/env.csv, <out>/env_overhead.csv, a PNG per asset, map and N, and (python3 with
-// matplotlib) the error-against-time plot through scripts/plot_env.py.
+// Then the split alone, without rendering (--no-split skips it): for each of --split-maps, the
+// map's build and split times, then for every threshold rule and light count the irradiance error
+// of lights + ambient against the map's brute-force irradiance, at the 6 axes and at random normals
+// (docs/measurements/environment.md "Threshold and light count").
+//
+// Writes <out>/env.csv, <out>/env_overhead.csv, <out>/env_split_cost.csv, <out>/env_split.csv, a PNG
+// per asset, map and N, and (python3 with matplotlib) the error-against-time plot through
+// scripts/plot_env.py.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -30,10 +38,11 @@
 #include "benchmarks/bench_commands.h"
 #include "benchmarks/bench_images.h"
 #include "benchmarks/bench_timing.h"
+#include "importers/environment_image.h"
 #include "importers/scene_loader.h"
-#include "renderer/core/error.h"
-#include "renderer/integrator/render.h"
-#include "renderer/output/image_output.h"
+#include "core/error.h"
+#include "integrator/render.h"
+#include "output/image_output.h"
 #include "shading/environment_map.h"
 
 namespace whitted::app {
@@ -60,6 +69,10 @@ struct BenchEnvOptions {
     int overhead_repeat = 7;                               ///< timed runs per scene and variant (interleaved); the median is reported
     bool overhead = true;                                  ///< measure the lookup cost at all
     std::string out = "bench-env";                         ///< output directory (CSV, images, plot)
+    bool split = true;                                     ///< measure the split alone (env_split*.csv)
+    std::vector<std::string> split_maps;                   ///< its maps; empty = every bundled one
+    std::vector<int> split_counts{4, 16, 64, 128, 256};    ///< its light counts
+    int split_normals = 100;                               ///< random normals its error is measured at (besides the 6 axes)
     bool plot = true;                                      ///< run scripts/plot_env.py afterwards when possible
     std::string python = default_python();                        ///< interpreter with matplotlib for the plot
 };
@@ -325,9 +338,109 @@ void lookup_overhead(const BenchEnvOptions& o, const std::string& map, const fs:
     }
 }
 
+// ---- the split alone: threshold rule and light count against irradiance error ----------------------
+
+/// CPU time of the calling thread, seconds.
+double thread_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+/// `count` unit directions, uniform on the sphere, from a fixed seed.
+std::vector<Vec3f> random_directions(int count, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<float> g;
+    std::vector<Vec3f> out;
+    while (int(out.size()) < count) {
+        const Vec3f d{g(rng), g(rng), g(rng)};
+        if (length(d) > 1e-3f) out.push_back(normalize(d));
+    }
+    return out;
+}
+
+float max_relative_error(const Color& got, const Color& want) {
+    float e = 0.f;
+    for (int c = 0; c < 3; ++c) e = std::max(e, std::fabs(got[c] - want[c]) / std::max(std::fabs(want[c]), 1e-12f));
+    return e;
+}
+
+/// For every map: build and split costs (thread CPU time); then per threshold rule and light count
+/// the worst relative irradiance error of lights + ambient at the 6 axes of studio and courtyard
+/// (those among the maps), and the largest and RMS error at random normals over every map.
+void split_table(const BenchEnvOptions& o, const fs::path& out) {
+    const std::vector<std::string> names = o.split_maps.empty() ? bundled_environment_names() : o.split_maps;
+    const std::vector<Vec3f> axes{{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    const std::vector<Vec3f> randoms = random_directions(o.split_normals, 29);
+    const std::vector<float> factors{0.f, 1.f / 16.f, 0.125f, 0.25f, 0.5f, 1.f, 2.f, 4.f};  // 0 = the default rule
+    std::ofstream cost(out / "env_split_cost.csv");
+    cost << "map,build_ms,split_ms_n16,split_ms_n128,split_ms_n256,bytes\n";
+    std::vector<EnvironmentMap> maps;
+    maps.reserve(names.size());
+    for (const std::string& name : names) {
+        std::vector<std::string> warnings;
+        Environment env;
+        env.image = std::make_shared<EnvironmentImage>(
+            load_environment_image(resolve_environment_name(name), size_t(1) << 30, warnings));
+        const double t0 = thread_seconds();
+        maps.emplace_back(env, 1);
+        const double t1 = thread_seconds();
+        maps.back().split(16);
+        const double t2 = thread_seconds();
+        maps.back().split(128);
+        const double t3 = thread_seconds();
+        maps.back().split(256);
+        const double t4 = thread_seconds();
+        cost << fmt::format("{},{:.0f},{:.0f},{:.0f},{:.0f},{}\n", label_of(name), 1e3 * (t1 - t0), 1e3 * (t2 - t1),
+                            1e3 * (t3 - t2), 1e3 * (t4 - t3), maps.back().bytes());
+    }
+    std::vector<std::vector<Color>> axis_ref, random_ref;
+    for (const EnvironmentMap& map : maps) {
+        axis_ref.emplace_back();
+        random_ref.emplace_back();
+        for (const Vec3f& n : axes) axis_ref.back().push_back(map.brute_force_irradiance(n));
+        for (const Vec3f& n : randoms) random_ref.back().push_back(map.brute_force_irradiance(n));
+    }
+    std::ofstream table(out / "env_split.csv");
+    table << "factor,correct_ambient,lights,axes_worst_studio_courtyard_pct,random_max_all_pct,random_rms_all_pct\n";
+    for (const bool correct : {true, false})
+        for (const float factor : factors) {
+            if (!correct && factor != 0.f) continue;
+            for (const int n : o.split_counts) {
+                SplitSettings settings;
+                settings.lights = n;
+                settings.threshold_factor = factor;
+                settings.correct_ambient = correct;
+                float axes_worst = 0.f, random_max = 0.f;
+                double squares = 0;
+                for (size_t m = 0; m < maps.size(); ++m) {
+                    const EnvironmentLighting lighting = maps[m].split(settings);
+                    if (label_of(names[m]) == "studio" || label_of(names[m]) == "courtyard")
+                        for (size_t i = 0; i < axes.size(); ++i)
+                            axes_worst = std::max(axes_worst, max_relative_error(lighting.irradiance(axes[i]), axis_ref[m][i]));
+                    for (size_t i = 0; i < randoms.size(); ++i) {
+                        const Color e = lighting.irradiance(randoms[i]);
+                        random_max = std::max(random_max, max_relative_error(e, random_ref[m][i]));
+                        for (int c = 0; c < 3; ++c)
+                            squares += std::pow((e[c] - random_ref[m][i][c]) / random_ref[m][i][c], 2.0);
+                    }
+                }
+                const double samples = std::max(1.0, 3.0 * double(randoms.size() * maps.size()));
+                table << fmt::format("{},{},{},{:.2f},{:.2f},{:.2f}\n",
+                                     factor == 0.f ? "2/sqrt(n)" : fmt::format("{:g}", factor), correct ? "yes" : "no",
+                                     n, 100.0 * axes_worst, 100.0 * random_max, 100.0 * std::sqrt(squares / samples));
+            }
+        }
+    if (!cost || !table) throw Error(fmt::format("bench env: cannot write the split tables in {}", out.string()));
+    std::printf("split: %zu maps, %zu light counts, %d random normals\n", maps.size(), o.split_counts.size(),
+                o.split_normals);
+}
+
 int run_bench_env(const BenchEnvOptions& o) {
     if (o.maps.empty()) throw Error("bench env: --maps: give at least one environment");
     if (o.lights.empty()) throw Error("bench env: --lights: give at least one count");
+    for (const int n : o.split_counts)
+        if (n < 0) throw Error(fmt::format("bench env: --split-counts: counts are 0 or more (got {})", n));
     for (const int n : o.lights)
         if (n < 0) throw Error(fmt::format("bench env: --lights: counts are 0 or more (got {})", n));
     (void)parse_aa_mode(o.aa);
@@ -342,8 +455,11 @@ int run_bench_env(const BenchEnvOptions& o) {
     const std::vector<Row> rows = light_sweep(o, counts, out);
     print_choice(o, counts, rows);
     if (o.overhead) lookup_overhead(o, o.maps.front(), out);
+    if (o.split) split_table(o, out);
     const std::string overhead_csv = o.overhead ? ", " + (out / "env_overhead.csv").string() : "";
-    std::printf("wrote %s%s\n", (out / "env.csv").c_str(), overhead_csv.c_str());
+    const std::string split_csv =
+        o.split ? ", " + (out / "env_split_cost.csv").string() + ", " + (out / "env_split.csv").string() : "";
+    std::printf("wrote %s%s%s\n", (out / "env.csv").c_str(), overhead_csv.c_str(), split_csv.c_str());
     if (o.plot) run_plot_script(o.python, "plot_env.py", out / "env.csv", out, "bench env");
     return 0;
 }
@@ -380,7 +496,16 @@ Command register_bench_env(CLI::App& bench) {
     app->add_option("--overhead-repeat", o->overhead_repeat, "Timed runs per scene and variant of the lookup-cost "
                     "measurement (the median is reported)")->check(CLI::Range(1, 100))->capture_default_str();
     app->add_flag("!--no-overhead", o->overhead, "Skip the lookup-cost measurement");
-    app->add_option("--out", o->out, "Output directory: env.csv, env_overhead.csv, PNGs, plot")->capture_default_str();
+    app->add_flag("!--no-split", o->split, "Skip the split measurement (threshold rule and light count against "
+                  "irradiance error, no rendering)");
+    app->add_option("--split-maps", o->split_maps, "Environments of the split measurement, comma-separated (default: "
+                    "every bundled one)")->delimiter(',');
+    app->add_option("--split-counts", o->split_counts, "Light counts of the split measurement, comma-separated")
+        ->delimiter(',')->capture_default_str();
+    app->add_option("--split-normals", o->split_normals, "Random normals the split's error is measured at (besides "
+                    "the 6 axes)")->check(CLI::Range(1, 100000))->capture_default_str();
+    app->add_option("--out", o->out, "Output directory: env.csv, env_overhead.csv, env_split*.csv, PNGs, plot")
+        ->capture_default_str();
     app->add_flag("!--no-plot", o->plot, "Do not run scripts/plot_env.py");
     app->add_option("--python", o->python, "Python interpreter with matplotlib for the plot")->capture_default_str();
     return Command{app, [o] { return run_bench_env(*o); }};

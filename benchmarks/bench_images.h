@@ -12,9 +12,9 @@
 
 #include <fmt/format.h>
 
-#include "renderer/core/log.h"
-#include "renderer/film/film.h"
-#include "renderer/output/image_output.h"
+#include "core/log.h"
+#include "film/film.h"
+#include "output/image_output.h"
 
 namespace whitted::app {
 

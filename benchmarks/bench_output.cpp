@@ -15,10 +15,10 @@
 #include <Imath/half.h>
 
 #include "importers/scene_loader.h"
-#include "renderer/core/image_files.h"
-#include "renderer/integrator/render.h"
-#include "renderer/output/image_output.h"
-#include "renderer/output/png_encoder.h"
+#include "core/image_files.h"
+#include "integrator/render.h"
+#include "output/image_output.h"
+#include "output/png_encoder.h"
 
 namespace {
 

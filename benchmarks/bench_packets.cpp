@@ -17,9 +17,10 @@
 #include <vector>
 
 #include "importers/scene_loader.h"
-#include "renderer/accel/accelerator.h"
-#include "renderer/integrator/camera.h"
-#include "renderer/integrator/scene_view.h"
+#include "accel/accelerator.h"
+#include "accel/factory/create_accelerator.h"
+#include "integrator/camera.h"
+#include "integrator/scene_view.h"
 
 namespace {
 

@@ -29,7 +29,7 @@
 #include <fmt/ranges.h>
 
 #include "benchmarks/bench_commands.h"
-#include "renderer/core/error.h"
+#include "core/error.h"
 
 extern char** environ;
 

@@ -27,9 +27,9 @@
 #include "benchmarks/bench_images.h"
 #include "benchmarks/bench_timing.h"
 #include "importers/scene_loader.h"
-#include "renderer/core/error.h"
-#include "renderer/core/log.h"
-#include "renderer/integrator/render.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "integrator/render.h"
 
 namespace whitted::app {
 

@@ -57,13 +57,13 @@
 #include "benchmarks/bench_timing.h"
 #include "benchmarks/ray_recording.h"
 #include "importers/scene_loader.h"
-#include "renderer/core/fp_mode.h"
-#include "renderer/accel/embree/embree_ray.h"
-#include "renderer/core/error.h"
-#include "renderer/core/log.h"
-#include "renderer/integrator/camera.h"
-#include "renderer/integrator/render.h"
-#include "renderer/output/image_output.h"
+#include "core/fp_mode.h"
+#include "accel/embree/embree_ray.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "integrator/camera.h"
+#include "integrator/render.h"
+#include "output/image_output.h"
 
 namespace whitted::app {
 

@@ -18,10 +18,10 @@
 #include "benchmarks/bench_commands.h"
 #include "benchmarks/stability_probes.h"
 #include "importers/scene_loader.h"
-#include "renderer/core/error.h"
-#include "renderer/core/ray_offset.h"
-#include "renderer/integrator/render.h"
-#include "renderer/scene/scene_builder.h"
+#include "core/error.h"
+#include "core/ray_offset.h"
+#include "integrator/render.h"
+#include "scene/scene_builder.h"
 #include "shading/optics.h"
 
 namespace whitted::app {
@@ -301,7 +301,7 @@ void run_energy(const BenchStabilityOptions& o, Csv& csv) {
 }
 
 void run_refraction(Csv& csv) {
-    std::printf("\n## 4b. Parallel slab: exit direction error |out - in| (shading/optics.h refract, float)\n\n"
+    std::printf("\n## 4b. Parallel slab: exit direction error |out - in| (src/shading/optics.h refract, float)\n\n"
                 "| incidence (deg) | ior 1.0 | ior 1.0001 | ior 1.5 | ior 2.4 |\n|---:|---:|---:|---:|---:|\n");
     for (double deg : {0.0, 45.0, 80.0, 89.0, 89.9, 89.95, 89.99, 89.999}) {
         std::printf("| %g |", deg);

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "benchmarks/bench_timing.h"
-#include "renderer/accel/accelerator.h"
+#include "accel/accelerator.h"
 
 namespace whitted::app {
 

@@ -18,12 +18,13 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "renderer/accel/common/sphere.h"
-#include "renderer/core/fp_mode.h"
-#include "renderer/core/ray_offset.h"
-#include "renderer/integrator/camera.h"
-#include "renderer/integrator/scene_view.h"
-#include "renderer/integrator/shading_frame.h"
+#include "accel/common/sphere.h"
+#include "accel/factory/create_accelerator.h"
+#include "core/fp_mode.h"
+#include "core/ray_offset.h"
+#include "integrator/camera.h"
+#include "integrator/scene_view.h"
+#include "integrator/shading_frame.h"
 #include "shading/light_sample.h"
 #include "shading/optics.h"
 
@@ -800,7 +801,7 @@ namespace {
 
 /// The integrator's ray tree with the local model replaced by its bound: shadows and cosines at
 /// 1, every light counted. Orientation, directions and offsets come from the integrator's own
-/// helpers (shading_frame.h, shading/optics.h), so only the tree's shape is written twice.
+/// helpers (shading_frame.h, src/shading/optics.h), so only the tree's shape is written twice.
 class BoundTracer {
 public:
     BoundTracer(const SceneView& view, const Accelerator& accel, const IntegratorSettings& s)

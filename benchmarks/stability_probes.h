@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "renderer/accel/accelerator.h"
-#include "renderer/integrator/render.h"
-#include "renderer/scene/scene.h"
+#include "accel/accelerator.h"
+#include "integrator/render.h"
+#include "scene/scene.h"
 
 namespace whitted::stress {
 

@@ -10,8 +10,8 @@
 
 #include "importers/scene_loader.h"
 #include "importers/scene_report.h"
-#include "renderer/core/error.h"
-#include "renderer/core/log.h"
+#include "core/error.h"
+#include "core/log.h"
 
 namespace whitted::fuzz {
 

@@ -4,7 +4,7 @@
 #include <cstdint>
 
 #include "importers/image_decode.h"
-#include "renderer/core/error.h"
+#include "core/error.h"
 #include "shading/texture_sampling.h"
 
 namespace {

@@ -17,9 +17,10 @@
 
 #include <fmt/format.h>
 
-#include "renderer/core/data_files.h"
-#include "renderer/core/log.h"
-#include "renderer/core/parallel.h"
+#include "accel/factory/create_accelerator.h"
+#include "core/data_files.h"
+#include "core/log.h"
+#include "core/parallel.h"
 #include "whitted/whitted.h"
 
 namespace py = pybind11;

@@ -7,7 +7,7 @@ Each TILE_LOG is what `whitted render --tile-log FILE` writes (one row per tile:
 y1, seconds, bytes, the estimated cost the tile was ordered by, and the run's scene, tile_size,
 threads, startup seconds). Two orders of the queue are simulated: "frame" (row by row) and "cost"
 (the estimate's dearest first, as `--tile-order cost` hands them out). The model, the protocol of
-renderer/session/mpi_frame.cpp:
+src/session/mpi_frame.cpp:
   - every rank starts after `startup` seconds (MPI_Init + load + accelerator build, measured);
   - ranks 1..N-1 ask rank 0 for BATCH tiles and ask again when half of a batch is left; rank 0
     gives them until their estimated work reaches SHARE / N of the work left (guided: batches

@@ -10,9 +10,9 @@
 
 #include "importers/scene_loader.h"
 #include "reference/reference_renderer.h"
-#include "renderer/core/error.h"
-#include "renderer/film/film.h"
-#include "renderer/output/image_output.h"
+#include "core/error.h"
+#include "film/film.h"
+#include "output/image_output.h"
 
 using namespace whitted;
 

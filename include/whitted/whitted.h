@@ -31,15 +31,16 @@
 
 #include "importers/scene_loader.h"
 #include "importers/scene_report.h"
-#include "renderer/accel/accelerator.h"
-#include "renderer/core/error.h"
-#include "renderer/film/film.h"
-#include "renderer/integrator/render.h"
-#include "renderer/integrator/render_settings.h"
-#include "renderer/integrator/scene_view.h"
-#include "renderer/output/image_output.h"
-#include "renderer/scene/scene.h"
-#include "renderer/session/frame_render.h"
+#include "accel/accelerator.h"
+#include "accel/factory/create_accelerator.h"
+#include "core/error.h"
+#include "film/film.h"
+#include "integrator/render.h"
+#include "integrator/render_settings.h"
+#include "integrator/scene_view.h"
+#include "output/image_output.h"
+#include "scene/scene.h"
+#include "session/frame_render.h"
 
 namespace whitted {
 

@@ -17,8 +17,9 @@
 #include <utility>
 #include <vector>
 
-#include "renderer/accel/accelerator.h"
-#include "renderer/core/error.h"
+#include "accel/accelerator.h"
+#include "accel/factory/create_accelerator.h"
+#include "core/error.h"
 #include "tests/support/test_accel_util.h"
 
 namespace whitted {

@@ -28,7 +28,8 @@ const std::string kScene = std::string(WHITTED_ASSETS_DIR) + "/scenes/whitted198
 TEST(BenchEnvCli, CsvColumnsReferenceRowAndAListedDefault) {
     const fs::path out = whitted::test::scratch_dir("whitted_bench_env_cli", "sweep");
     const Result r = run("bench env '" + kBox + "' --maps studio --lights 0,16 --reference 16 --width 24 --repeat 1 "
-                         "--threads 1 --overhead-scenes '" + kScene + "' --overhead-repeat 1 --no-plot --out '" +
+                         "--threads 1 --overhead-scenes '" + kScene + "' --overhead-repeat 1 --split-maps studio,courtyard "
+                         "--split-counts 4,16 --split-normals 8 --no-plot --out '" +
                          out.string() + "'");
     ASSERT_EQ(r.code, 0) << r.out << r.err;
 
@@ -70,6 +71,22 @@ TEST(BenchEnvCli, CsvColumnsReferenceRowAndAListedDefault) {
     EXPECT_EQ(overhead[0].at("scene"), "whitted1980");
     EXPECT_TRUE(std::isfinite(num(overhead[0], "ratio")));
     EXPECT_EQ(overhead[0].at("plain_total_rays"), overhead[0].at("env_total_rays"));  // lookups only, no extra ray
+
+    // The split alone: a cost row per map, an error row per threshold rule and count (8 rules with the
+    // ambient correction, the default rule without), errors finite and the default rule's small.
+    const std::vector<Row> cost = read_csv(out / "env_split_cost.csv", &header);
+    ASSERT_EQ(cost.size(), 2u);
+    EXPECT_EQ(cost[0].at("map"), "studio");
+    EXPECT_GT(num(cost[1], "bytes"), 0.0);
+    const std::vector<Row> split = read_csv(out / "env_split.csv", &header);
+    for (const char* column : {"factor", "correct_ambient", "lights", "axes_worst_studio_courtyard_pct",
+                               "random_max_all_pct", "random_rms_all_pct"})
+        EXPECT_NE(std::find(header.begin(), header.end(), column), header.end()) << column;
+    ASSERT_EQ(split.size(), 9u * 2u);
+    for (const Row& row : split) EXPECT_TRUE(std::isfinite(num(row, "random_rms_all_pct"))) << row.at("factor");
+    EXPECT_EQ(split[0].at("factor"), "2/sqrt(n)");
+    EXPECT_EQ(split[0].at("correct_ambient"), "yes");
+    EXPECT_LT(num(split[1], "random_max_all_pct"), 25.0);  // 16 lights, the default rule: 14.8 % over the six maps
 }
 
 TEST(BenchEnvCli, NegativeCountIsOneErrorLine) {

@@ -182,6 +182,64 @@ TEST(Cli, HelpDocumentsFlagsWithDefaults) {
     EXPECT_NE(r.out.find("=5"), std::string::npos) << "max-depth default shown";
 }
 
+/// The camera rays of a render's summary ("rays   camera N ...").
+long long camera_rays(const std::string& err) {
+    const std::string key = "rays   camera ";
+    const size_t at = err.find(key);
+    return at == std::string::npos ? -1 : std::stoll(err.substr(at + key.size()));
+}
+
+// One frame path: samples that tiles share are traced once in a process, so the 4 corners of
+// --aa corners cost exactly (W+1)(H+1) camera rays whatever the tiles and threads, and adaptive
+// anti-aliasing traces the same rays too.
+TEST(Cli, SharedSamplesAreTracedOnceForAnyTileSizeAndThreads) {
+    const std::string scene = std::string(WHITTED_ASSETS_DIR) + "/scenes/whitted1980.json";
+    const fs::path out = fs::temp_directory_path() / ("whitted_cli_corners_" + std::to_string(::getpid()) + ".exr");
+    for (const char* aa : {"corners", "adaptive"}) {
+        long long first = -1;
+        for (const char* tiling : {"--tile-size 7 --threads 1", "--tile-size 32 --threads 2", "--tile-size 64 --threads 3",
+                                   "--tile-size 13 --threads 3"}) {
+            const Result r = run("render '" + scene + "' --width 60 --height 45 --no-progress --aa " + aa + " " + tiling +
+                                 " -o '" + out.string() + "'");
+            ASSERT_EQ(r.code, 0) << r.err;
+            const long long rays = camera_rays(r.err);
+            if (std::string(aa) == "corners") EXPECT_EQ(rays, 61 * 46) << tiling;
+            if (first < 0) first = rays;
+            EXPECT_EQ(rays, first) << aa << " " << tiling;
+        }
+    }
+    fs::remove(out);
+}
+
+// `render --help` shows the flags in groups by task, measurement knobs under Diagnostics.
+TEST(Cli, HelpGroupsFlagsByTask) {
+    const Result r = run("render --help");
+    ASSERT_EQ(r.code, 0);
+    size_t last = 0;
+    for (const char* group : {"Output", "Sampling", "Lighting", "Acceleration", "Distributed", "Diagnostics"}) {
+        const size_t at = r.out.find(std::string("[Option Group: ") + group + "]");
+        ASSERT_NE(at, std::string::npos) << group << "\n" << r.out;
+        EXPECT_GT(at, last) << group;  // in this order
+        last = at;
+    }
+    const size_t diagnostics = r.out.find("[Option Group: Diagnostics]");
+    for (const char* knob : {"--no-specialize", "--tile-order", "--tile-log"})
+        EXPECT_GT(r.out.find(knob), diagnostics) << knob;
+    EXPECT_LT(r.out.find("--aa-threshold"), r.out.find("[Option Group: Lighting]"));
+}
+
+// `info` of a scene under an environment with hundreds of lights fits a screen; --verbose lists all.
+TEST(Cli, InfoSummarisesEnvironmentLights) {
+    Result r = run("info '" + kBox + "' --environment studio --env-lights 256");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_LE(line_count(r.out), 60u) << r.out;
+    EXPECT_NE(r.out.find("lights_share="), std::string::npos) << r.out;
+    const Result v = run("info '" + kBox + "' --environment studio --env-lights 256 --verbose");
+    ASSERT_EQ(v.code, 0) << v.err;
+    EXPECT_NE(v.out.find("light[255]: "), std::string::npos) << v.out;
+    EXPECT_GT(line_count(v.out), 256u);
+}
+
 TEST(Cli, InfoPrintsCounts) {
     Result r = run("info '" + kBox + "'");
     EXPECT_EQ(r.code, 0) << r.err;

@@ -188,6 +188,38 @@ TEST(Session, TileJobsMergeToTheOnePieceFrame) {
     EXPECT_EQ(read_pixels(dir / "cm.exr"), read_pixels(dir / "crop.exr"));
 }
 
+/// How an EXR stores its beauty's R channel: "float" or "half".
+std::string beauty_format(const fs::path& path) {
+    auto in = OIIO::ImageInput::open(path.string());
+    if (!in) return "unreadable";
+    const OIIO::ImageSpec& spec = in->spec();
+    const int r = spec.channelindex("R");
+    return r < 0 ? "no R" : std::string(spec.channelformat(r).c_str());
+}
+
+// `whitted merge` is lossless by default: float parts (what --tile-job writes) give a float EXR
+// equal to the one-piece float render; --exr-half asks for half, and with --exr-float it is refused.
+TEST(Session, MergeKeepsThePartsPrecision) {
+    const fs::path dir = scratch_dir("whitted_session", "merge_precision");
+    const std::string render = "render " + q(kRoom) + " --width 96 --no-progress";
+    ASSERT_EQ(run(render + " --exr-float -o " + q(dir / "one.exr")).code, 0);
+    ASSERT_EQ(run(render + " --tile-job 1/2 -o " + q(dir / "p1.exr")).code, 0);
+    ASSERT_EQ(run(render + " --tile-job 2/2 -o " + q(dir / "p2.exr")).code, 0);
+    EXPECT_EQ(beauty_format(dir / "p1.exr"), "float");
+    const std::string parts = " " + q(dir / "p1.exr") + " " + q(dir / "p2.exr");
+    Result m = run("merge" + parts + " -o " + q(dir / "merged.exr"));
+    ASSERT_EQ(m.code, 0) << m.err;
+    EXPECT_EQ(beauty_format(dir / "merged.exr"), "float");
+    EXPECT_EQ(read_pixels(dir / "merged.exr"), read_pixels(dir / "one.exr"));
+    m = run("merge" + parts + " --exr-half -o " + q(dir / "half.exr"));
+    ASSERT_EQ(m.code, 0) << m.err;
+    EXPECT_EQ(beauty_format(dir / "half.exr"), "half");
+    EXPECT_NE(read_pixels(dir / "half.exr"), read_pixels(dir / "one.exr"));  // rounded to half
+    m = run("merge" + parts + " --exr-half --exr-float -o " + q(dir / "both.exr"));
+    EXPECT_EQ(m.code, 2) << m.err;
+    EXPECT_FALSE(fs::exists(dir / "both.exr"));
+}
+
 // --tile-log: a row per tile with its time and message size, for scripts/simulate_mpi.py.
 TEST(Session, TileLogHasARowPerTile) {
     const fs::path dir = scratch_dir("whitted_session", "tilelog");

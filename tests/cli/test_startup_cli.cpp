@@ -70,7 +70,7 @@ TEST(StartupCli, RendersToEveryFormatDoNotLoadOpenImageIOReadingAPngDoes) {
 }
 
 // Runs that load or render restart once with glibc's malloc asking for transparent huge pages
-// (renderer/core/huge_pages.h) when the kernel offers them, except runs whose only files are small
+// (src/core/huge_pages.h) when the kernel offers them, except runs whose only files are small
 // scene files; WHITTED_HUGE_PAGES=0 and a caller's own GLIBC_TUNABLES setting are respected.
 TEST(StartupCli, RunsAskForHugePagesWhenTheKernelOffersThem) {
     const std::string thp = slurp("/sys/kernel/mm/transparent_hugepage/enabled");

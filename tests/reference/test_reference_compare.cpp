@@ -19,10 +19,10 @@
 
 #include "importers/scene_loader.h"
 #include "reference/reference_renderer.h"
-#include "renderer/core/error.h"
-#include "renderer/integrator/camera.h"
-#include "renderer/integrator/render.h"
-#include "renderer/scene/scene_builder.h"
+#include "core/error.h"
+#include "integrator/camera.h"
+#include "integrator/render.h"
+#include "scene/scene_builder.h"
 
 namespace whitted {
 namespace {

@@ -10,9 +10,10 @@
 #include <utility>
 #include <vector>
 
-#include "renderer/core/error.h"
-#include "renderer/integrator/render.h"
-#include "renderer/scene/scene_builder.h"
+#include "accel/factory/create_accelerator.h"
+#include "core/error.h"
+#include "integrator/render.h"
+#include "scene/scene_builder.h"
 
 namespace whitted {
 namespace {

@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <vector>
 
-#include "renderer/integrator/render.h"
-#include "renderer/scene/scene_builder.h"
+#include "integrator/render.h"
+#include "scene/scene_builder.h"
 #include "shading/texture_sampling.h"
 
 namespace whitted {

@@ -14,8 +14,9 @@
 #include <cstdio>
 #include <random>
 
+#include "accel/factory/create_accelerator.h"
 #include "importers/scene_loader.h"
-#include "renderer/integrator/render.h"
+#include "integrator/render.h"
 #include "tests/support/test_accel_util.h"
 
 namespace whitted {

@@ -8,8 +8,8 @@
 #include <random>
 #include <string>
 
-#include "renderer/integrator/render.h"
-#include "renderer/scene/scene_builder.h"
+#include "integrator/render.h"
+#include "scene/scene_builder.h"
 #include "shading/light_sample.h"
 #include "shading/optics.h"
 

@@ -15,8 +15,8 @@
 #include <string>
 
 #include "importers/scene_loader.h"
-#include "renderer/integrator/render.h"
-#include "renderer/scene/scene_builder.h"
+#include "integrator/render.h"
+#include "scene/scene_builder.h"
 #include "tests/support/meshopt_reencode.h"
 
 namespace whitted {

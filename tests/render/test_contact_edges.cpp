@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "renderer/integrator/render.h"
-#include "renderer/integrator/whitted_integrator.h"
-#include "renderer/scene/scene_builder.h"
+#include "integrator/render.h"
+#include "integrator/whitted_integrator.h"
+#include "scene/scene_builder.h"
 
 namespace whitted {
 namespace {

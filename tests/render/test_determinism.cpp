@@ -9,9 +9,9 @@
 #include <random>
 #include <vector>
 
-#include "renderer/core/fp_mode.h"
-#include "renderer/integrator/render.h"
-#include "renderer/scene/scene_builder.h"
+#include "core/fp_mode.h"
+#include "integrator/render.h"
+#include "scene/scene_builder.h"
 
 namespace whitted {
 namespace {
@@ -120,13 +120,14 @@ TEST(Determinism, EveryAaModeIsIndependentOfThreadsAndTiles) {
     }
 }
 
-// Renderer::render_tiles, the path of distributed, resumed and tile-job renders: each tile on its
-// own (shared samples traced by both neighbours), in any order, pasted together, is render()'s
-// image, every buffer bit for bit, in every anti-aliasing mode.
+// Renderer::render_tiles, the one frame path (render(), distributed, resumed and tile-job renders):
+// the tiles in any order, pasted together, are render()'s image, every buffer bit for bit, in every
+// anti-aliasing mode, and the samples neighbouring tiles share are traced once (the same rays).
 TEST(Determinism, TilesRenderedAloneInAnyOrderMakeTheSameImage) {
     const Scene s = glass_and_shadows_scene();
     for (const AaSettings& aa : all_aa_modes()) {
-        const Film reference = render(s, 1, 32, aa);
+        RenderStats ref_stats;
+        const Film reference = render(s, 1, 32, aa, &ref_stats);
         for (auto [threads, tile] : {std::pair{2, 7}, std::pair{3, 16}, std::pair{1, 200}}) {
             RenderSettings rs;
             rs.width = 97;
@@ -147,10 +148,49 @@ TEST(Determinism, TilesRenderedAloneInAnyOrderMakeTheSameImage) {
                            [&](size_t, Film&& f) { assembled.paste(f); ++finished; }, &stats);
             EXPECT_EQ(finished, n);
             EXPECT_EQ(stats.pixels, 97u * 61u);
+            EXPECT_EQ(stats.rays.camera, ref_stats.rays.camera) << aa_mode_name(aa.mode) << " tile " << tile;
+            EXPECT_EQ(stats.rays.total(), ref_stats.rays.total()) << aa_mode_name(aa.mode) << " tile " << tile;
             EXPECT_TRUE(bit_identical(reference, assembled))
                 << aa_mode_name(aa.mode) << " t=" << aa.threshold << ": " << threads << " threads, tile " << tile;
         }
     }
+}
+
+// A process that renders only some of the tiles (an MPI rank, a resumed render) traces their
+// samples alone: its tiles are render()'s pixels, and the corners along its own borders are traced
+// again by whoever renders the neighbours: --aa corners over the even tiles traces exactly the
+// corners of those tiles, each once.
+TEST(Determinism, SomeTilesTraceOnlyTheirOwnCorners) {
+    const Scene s = glass_and_shadows_scene();
+    AaSettings aa;
+    aa.mode = AaMode::Corners;
+    const Film reference = render(s, 1, 32, aa);
+    RenderSettings rs;
+    rs.width = 97;
+    rs.height = 61;
+    rs.threads = 3;
+    rs.tile_size = 10;
+    rs.aa = aa;
+    const Renderer r(s, rs);
+    const std::vector<TileRect> tiles = r.tiles();
+    std::vector<size_t> mine;
+    for (size_t i = 0; i < tiles.size(); i += 2) mine.push_back(i);
+    std::vector<uint8_t> corner(98u * 62u, 0);
+    for (const size_t i : mine)
+        for (int y = tiles[i].y0; y <= tiles[i].y1; ++y)
+            for (int x = tiles[i].x0; x <= tiles[i].x1; ++x) corner[size_t(y) * 98u + size_t(x)] = 1;
+    size_t handed = 0;
+    RenderStats stats;
+    Film assembled(97, 61, PixelWindow{0, 0, 97, 61}, rs.aovs);
+    r.render_tiles([&]() -> std::optional<size_t> { return handed < mine.size() ? std::optional(mine[handed++]) : std::nullopt; },
+                   [&](size_t, Film&& f) {
+                       for (int y = f.window.y0; y < f.window.y1; ++y)
+                           for (int x = f.window.x0; x < f.window.x1; ++x)
+                               EXPECT_EQ(std::memcmp(&f.beauty[f.index(x, y)], &reference.beauty[reference.index(x, y)],
+                                                     sizeof(Color)), 0) << x << "," << y;
+                   },
+                   &stats);
+    EXPECT_EQ(stats.rays.camera, uint64_t(std::count(corner.begin(), corner.end(), uint8_t(1))));
 }
 
 TEST(Determinism, EveryAaModeCropsToTheSamePixels) {
@@ -186,7 +226,7 @@ TEST(Determinism, CropRendersTheSamePixelsAsTheFullImage) {
         for (int x = 10; x < 60; ++x) ASSERT_EQ(crop.beauty[crop.index(x, y)], full.beauty[full.index(x, y)]);
 }
 
-// The renderer traces with flush-to-zero / denormals-are-zero (renderer/core/fp_mode.h) but is a
+// The renderer traces with flush-to-zero / denormals-are-zero (src/core/fp_mode.h) but is a
 // library: the calling thread's floating-point mode must be the same after constructing a Renderer
 // and after render() (with 1 and 2 threads; the caller's thread works in the arena too), and
 // denormal arithmetic must work again afterwards. Setting FTZ/DAZ and leaving it set fails this.

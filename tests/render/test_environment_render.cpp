@@ -13,9 +13,9 @@
 #include <string>
 
 #include "importers/scene_loader.h"
-#include "renderer/core/error.h"
-#include "renderer/integrator/render.h"
-#include "renderer/scene/scene_builder.h"
+#include "core/error.h"
+#include "integrator/render.h"
+#include "scene/scene_builder.h"
 #include "shading/environment_map.h"
 
 namespace whitted {

@@ -4,9 +4,9 @@
 
 #include <cmath>
 
-#include "renderer/core/error.h"
-#include "renderer/integrator/render.h"
-#include "renderer/scene/scene_builder.h"
+#include "core/error.h"
+#include "integrator/render.h"
+#include "scene/scene_builder.h"
 
 namespace whitted {
 namespace {

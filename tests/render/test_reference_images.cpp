@@ -16,8 +16,8 @@
 #include <string>
 
 #include "importers/scene_loader.h"
-#include "renderer/integrator/render.h"
-#include "renderer/output/image_output.h"
+#include "integrator/render.h"
+#include "output/image_output.h"
 
 namespace whitted {
 namespace {

@@ -9,9 +9,10 @@
 #include <string>
 #include <vector>
 
+#include "accel/factory/create_accelerator.h"
 #include "importers/scene_loader.h"
-#include "renderer/integrator/render.h"
-#include "renderer/scene/scene_builder.h"
+#include "integrator/render.h"
+#include "scene/scene_builder.h"
 #include "shading/environment_map.h"
 #include "shading/scene_analysis.h"
 

@@ -9,10 +9,10 @@
 #include <optional>
 #include <vector>
 
-#include "renderer/core/error.h"
-#include "renderer/integrator/render.h"
-#include "renderer/scene/scene_builder.h"
-#include "renderer/session/frame_render.h"
+#include "core/error.h"
+#include "integrator/render.h"
+#include "scene/scene_builder.h"
+#include "session/frame_render.h"
 
 namespace whitted {
 namespace {

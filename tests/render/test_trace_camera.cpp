@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "importers/scene_loader.h"
-#include "renderer/integrator/camera.h"
-#include "renderer/integrator/render.h"
-#include "renderer/integrator/whitted_integrator.h"
+#include "integrator/camera.h"
+#include "integrator/render.h"
+#include "integrator/whitted_integrator.h"
 
 namespace whitted {
 namespace {

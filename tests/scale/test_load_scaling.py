@@ -54,7 +54,7 @@ def node_file(path, n):
 
 
 def instructions(exe, path):
-    # whitted's huge-page restart (renderer/core/huge_pages.h) is skipped under valgrind; the
+    # whitted's huge-page restart (src/core/huge_pages.h) is skipped under valgrind; the
     # variable says so explicitly, so the count is of one process either way.
     env = dict(os.environ, WHITTED_HUGE_PAGES="0")
     r = subprocess.run(["valgrind", "--tool=cachegrind", "--cache-sim=no", "--cachegrind-out-file=/dev/null",

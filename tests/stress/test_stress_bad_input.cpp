@@ -14,7 +14,7 @@
 
 #include "benchmarks/stability_probes.h"
 #include "importers/scene_loader.h"
-#include "renderer/scene/scene_builder.h"
+#include "scene/scene_builder.h"
 #include "tests/support/test_importer_util.h"
 
 namespace whitted::stress {

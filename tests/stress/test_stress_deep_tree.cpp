@@ -7,8 +7,8 @@
 #include <string>
 
 #include "benchmarks/stability_probes.h"
-#include "renderer/core/error.h"
-#include "renderer/scene/scene_builder.h"
+#include "core/error.h"
+#include "scene/scene_builder.h"
 
 namespace whitted::stress {
 namespace {

@@ -9,9 +9,9 @@
 
 #include "benchmarks/stability_probes.h"
 #include "importers/scene_loader.h"
-#include "renderer/core/ray_offset.h"
-#include "renderer/integrator/whitted_integrator.h"
-#include "renderer/scene/scene_builder.h"
+#include "core/ray_offset.h"
+#include "integrator/whitted_integrator.h"
+#include "scene/scene_builder.h"
 #include "shading/optics.h"
 
 namespace whitted::stress {
@@ -167,7 +167,7 @@ TEST(StressRefraction, SlabWithIorOneIsInvisible) {
     }
 }
 
-// The integrator's refraction (shading/optics.h refract, oriented as in shade()) through the two
+// The integrator's refraction (src/shading/optics.h refract, oriented as in shade()) through the two
 // faces of a parallel slab: the ray leaves parallel to how it entered, displaced by Snell's law.
 TEST(StressRefraction, ParallelSlabExitDirectionAndShift) {
     for (float ior : {1.0f, 1.0001f, 1.5f, 2.4f})

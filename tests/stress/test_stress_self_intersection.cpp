@@ -10,7 +10,7 @@
 #include <string>
 
 #include "benchmarks/stability_probes.h"
-#include "renderer/core/ray_offset.h"
+#include "core/ray_offset.h"
 
 namespace whitted::stress {
 namespace {

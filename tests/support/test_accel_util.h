@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "renderer/accel/accelerator.h"
-#include "renderer/accel/common/geometry.h"
-#include "renderer/scene/scene.h"
+#include "accel/accelerator.h"
+#include "accel/common/geometry.h"
+#include "scene/scene.h"
 
 namespace whitted::test {
 

@@ -13,7 +13,7 @@
 #include <unistd.h>
 
 #include "importers/scene_loader.h"
-#include "renderer/core/error.h"
+#include "core/error.h"
 
 namespace whitted::test {
 

@@ -18,10 +18,11 @@
 #include <functional>
 #include <memory>
 
+#include "accel/factory/create_accelerator.h"
 #include "importers/scene_loader.h"
-#include "renderer/accel/bvh/bvh_accel.h"
-#include "renderer/accel/bvh/wide_bvh.h"
-#include "renderer/core/error.h"
+#include "accel/bvh/bvh_accel.h"
+#include "accel/bvh/wide_bvh.h"
+#include "core/error.h"
 #include "tests/support/test_accel_util.h"
 
 namespace whitted {

@@ -7,8 +7,8 @@
 #include <random>
 #include <vector>
 
-#include "renderer/output/code_table.h"
-#include "renderer/output/image_output.h"
+#include "output/code_table.h"
+#include "output/image_output.h"
 
 namespace whitted {
 namespace {

@@ -13,7 +13,6 @@
 #include <string>
 #include <vector>
 
-#include <time.h>
 #include <unistd.h>
 
 #include <OpenImageIO/imageio.h>
@@ -21,7 +20,7 @@
 #include <gtest/gtest.h>
 
 #include "importers/environment_image.h"
-#include "renderer/core/error.h"
+#include "core/error.h"
 #include "shading/environment_map.h"
 
 namespace whitted {
@@ -587,75 +586,6 @@ TEST_F(EnvironmentLoad, BundledNames) {
         EXPECT_NE(m.find("moonbase"), std::string::npos) << m;
         EXPECT_NE(m.find("studio, city, courtyard, forest, interior, sunset"), std::string::npos) << m;
     }
-}
-
-
-// ---- measurement (run by hand: docs/measurements/environment.md) ---------------------------------
-
-/// CPU time of the calling thread, seconds.
-double thread_seconds() {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
-TEST(EnvironmentMeasure, DISABLED_ThresholdAndLightCount) {
-    // For every bundled map: the build and split costs, then the irradiance error of lights +
-    // ambient per threshold rule and light count, at the 6 axes and at 100 random normals.
-    const std::vector<Vec3f> randoms = random_directions(100, 29);
-    const std::vector<int> counts{4, 16, 64, 128, 256};
-    const std::vector<float> factors{0.f, 1.f / 16.f, 0.125f, 0.25f, 0.5f, 1.f, 2.f, 4.f};  // 0 = the default rule
-    std::printf("map,build_ms,split_ms_n16,split_ms_n128,split_ms_n256,bytes\n");
-    std::vector<EnvironmentMap> maps;
-    for (const std::string& name : bundled_environment_names()) {
-        const Environment env = bundled(name);
-        const double t0 = thread_seconds();
-        maps.emplace_back(env, 1);
-        const double t1 = thread_seconds();
-        maps.back().split(16);
-        const double t2 = thread_seconds();
-        maps.back().split(128);
-        const double t3 = thread_seconds();
-        maps.back().split(256);
-        const double t4 = thread_seconds();
-        std::printf("%s,%.0f,%.0f,%.0f,%.0f,%zu\n", name.c_str(), 1e3 * (t1 - t0), 1e3 * (t2 - t1), 1e3 * (t3 - t2),
-                    1e3 * (t4 - t3), maps.back().bytes());
-    }
-    std::vector<std::vector<Color>> axis_ref, random_ref;
-    for (const EnvironmentMap& map : maps) {
-        axis_ref.emplace_back();
-        random_ref.emplace_back();
-        for (const Vec3f& n : axes()) axis_ref.back().push_back(map.brute_force_irradiance(n));
-        for (const Vec3f& n : randoms) random_ref.back().push_back(map.brute_force_irradiance(n));
-    }
-    std::printf("factor,correct_ambient,lights,axes_worst_studio_courtyard_pct,random_max_all_pct,random_rms_all_pct\n");
-    for (const bool correct : {true, false})
-        for (const float factor : factors) {
-            if (!correct && factor != 0.f) continue;
-            for (const int n : counts) {
-                SplitSettings settings;
-                settings.lights = n;
-                settings.threshold_factor = factor;
-                settings.correct_ambient = correct;
-                float axes_worst = 0.f, random_max = 0.f;
-                double squares = 0;
-                for (size_t m = 0; m < maps.size(); ++m) {
-                    const EnvironmentLighting lighting = maps[m].split(settings);
-                    const std::string& name = bundled_environment_names()[m];
-                    if (name == "studio" || name == "courtyard")
-                        for (size_t i = 0; i < axes().size(); ++i)
-                            axes_worst = std::max(axes_worst, max_relative_error(lighting.irradiance(axes()[i]), axis_ref[m][i]));
-                    for (size_t i = 0; i < randoms.size(); ++i) {
-                        const Color e = lighting.irradiance(randoms[i]);
-                        random_max = std::max(random_max, max_relative_error(e, random_ref[m][i]));
-                        for (int c = 0; c < 3; ++c) squares += std::pow((e[c] - random_ref[m][i][c]) / random_ref[m][i][c], 2.0);
-                    }
-                }
-                std::printf("%s,%s,%d,%.2f,%.2f,%.2f\n", factor == 0.f ? "2/sqrt(n)" : fmt::format("{:g}", factor).c_str(),
-                            correct ? "yes" : "no", n, 100.0 * axes_worst, 100.0 * random_max,
-                            100.0 * std::sqrt(squares / (3.0 * double(randoms.size() * maps.size()))));
-            }
-        }
 }
 
 }  // namespace

@@ -23,8 +23,8 @@
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
-#include "renderer/core/error.h"
-#include "renderer/output/image_output.h"
+#include "core/error.h"
+#include "output/image_output.h"
 
 namespace fs = std::filesystem;
 using namespace whitted;

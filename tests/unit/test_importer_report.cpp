@@ -1,5 +1,6 @@
 // `whitted info` text (describe_scene): stable, one greppable record per line.
 
+#include <algorithm>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -94,7 +95,63 @@ TEST(SceneReport, EnvironmentLightsAndAmbient) {
     EXPECT_TRUE(contains(env[0], "name=\"courtyard\" size=1024x512 rotation=0 exposure=0 visible=yes lights=4"))
         << env[0];
     EXPECT_EQ(lines_starting_with(text, "environment ambient: +X=").size(), 1u);
-    EXPECT_EQ(lines_starting_with(text, "light[3]: name=\"environment light 3\" type=directional").size(), 1u);
+    // Summarised: the four lights by their share, not a line each.
+    EXPECT_EQ(lines_starting_with(text, "environment light[").size(), 4u) << text;
+    EXPECT_EQ(lines_starting_with(text, "light[3]: ").size(), 0u) << text;
+    const std::string verbose = describe_scene(load_scene(asset("Box/glTF/Box.gltf"), o), ReportDetail::Verbose);
+    EXPECT_EQ(lines_starting_with(verbose, "light[3]: name=\"environment light 3\" type=directional").size(), 1u);
+}
+
+/// The number of lines of `text`.
+size_t line_count(const std::string& text) { return size_t(std::count(text.begin(), text.end(), '\n')); }
+
+/// The value of `key=` in `line` up to the next space (empty when absent).
+std::string field(const std::string& line, const std::string& key) {
+    const size_t at = line.find(" " + key + "=");
+    if (at == std::string::npos) return {};
+    const size_t from = at + key.size() + 2;
+    return line.substr(from, line.find(' ', from) - from);
+}
+
+// Hundreds of extracted lights fit a screen: the environment line gives their count and share of the
+// map's power, the brightest few follow, most powerful first; --verbose lists every one.
+TEST(SceneReport, ManyEnvironmentLightsAreSummarised) {
+    ImportOptions o;
+    o.environment = "studio";
+    o.environment_lights = 256;
+    const Scene scene = load_scene(asset("Box/glTF/Box.gltf"), o);
+    size_t extracted = 0;
+    for (const Light& l : scene.lights) extracted += l.from_environment;
+    ASSERT_GT(extracted, kBrightestEnvironmentLights);
+    const std::string text = describe_scene(scene);
+    EXPECT_LE(line_count(text), 60u) << text;
+    const auto env = lines_starting_with(text, "environment: ");
+    ASSERT_EQ(env.size(), 1u);
+    EXPECT_EQ(field(env[0], "lights"), std::to_string(extracted)) << env[0];
+    const std::string share = field(env[0], "lights_share");
+    ASSERT_FALSE(share.empty()) << env[0];
+    const double percent = std::stod(share);
+    EXPECT_GT(percent, 50.0) << env[0];  // the threshold leaves the ambient at most 1/16 of the light
+    EXPECT_LE(percent, 100.0) << env[0];
+    const auto brightest = lines_starting_with(text, "environment light[");
+    ASSERT_EQ(brightest.size(), kBrightestEnvironmentLights);
+    double previous = 101.0, sum = 0.0;
+    for (const std::string& l : brightest) {
+        const std::string s = field(l, "share_of_lights");
+        ASSERT_FALSE(s.empty()) << l;
+        const double v = std::stod(s.substr(0, s.size() - 1));
+        EXPECT_LE(v, previous) << l;  // most powerful first
+        previous = v;
+        sum += v;
+    }
+    EXPECT_LE(sum, 100.5);
+    EXPECT_EQ(lines_starting_with(text, "environment lights: ").size(), 1u) << text;
+    EXPECT_EQ(lines_starting_with(text, "analysis light[").size(), 0u) << text;
+
+    const std::string verbose = describe_scene(scene, ReportDetail::Verbose);
+    EXPECT_EQ(lines_starting_with(verbose, "light[").size(), scene.lights.size());
+    EXPECT_EQ(lines_starting_with(verbose, "analysis light[").size(), scene.lights.size());
+    EXPECT_EQ(lines_starting_with(verbose, "environment light[").size(), 0u);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// The in-house PNG encoder (renderer/output/png_encoder.h): files decode, through an independent
+// The in-house PNG encoder (src/output/png_encoder.h): files decode, through an independent
 // reader (OpenImageIO's libpng, which checks every CRC and the Adler-32), to exactly the codes
 // given, at 8 and 16 bits, for sizes that leave partial bands and one-row bands; the bytes do not
 // depend on the thread count; metadata comes back as text; write_image's PNG holds exactly
@@ -19,11 +19,11 @@
 #include <OpenImageIO/imageio.h>
 #include <tbb/global_control.h>
 
-#include "renderer/core/error.h"
-#include "renderer/core/image_files.h"
-#include "renderer/core/image_files_display.h"
-#include "renderer/output/image_output.h"
-#include "renderer/output/png_encoder.h"
+#include "core/error.h"
+#include "core/image_files.h"
+#include "core/image_files_display.h"
+#include "output/image_output.h"
+#include "output/png_encoder.h"
 
 namespace fs = std::filesystem;
 using namespace whitted;

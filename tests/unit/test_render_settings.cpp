@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "renderer/integrator/render_settings.h"
-#include "renderer/output/image_output.h"
+#include "integrator/render_settings.h"
+#include "output/image_output.h"
 
 namespace whitted {
 namespace {

@@ -12,7 +12,7 @@
 #include "importers/scene_file.h"
 #include "importers/scene_loader.h"
 #include "importers/scene_report.h"
-#include "renderer/core/error.h"
+#include "core/error.h"
 #include "tests/support/test_importer_util.h"
 
 namespace whitted::test {

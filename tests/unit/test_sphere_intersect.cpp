@@ -1,4 +1,4 @@
-// The ray/sphere kernel (renderer/accel/common/sphere.h) against the closed form in long double,
+// The ray/sphere kernel (src/accel/common/sphere.h) against the closed form in long double,
 // in float and double, over ray families that stress it: from outside, from inside (far root),
 // near-tangent, huge and tiny radii, centres far from the origin, origins on the surface. Prints
 // the median / max relative t error per family (docs/accelerators.md quotes them) and asserts
@@ -16,9 +16,10 @@
 #include <string>
 #include <vector>
 
-#include "renderer/accel/accelerator.h"
-#include "renderer/accel/common/planes.h"
-#include "renderer/accel/common/sphere.h"
+#include "accel/accelerator.h"
+#include "accel/factory/create_accelerator.h"
+#include "accel/common/planes.h"
+#include "accel/common/sphere.h"
 #include "tests/support/test_accel_util.h"
 
 namespace whitted {

@@ -1,0 +1,12 @@
+#include "accel/accelerator.h"
+
+#include "core/error.h"
+
+namespace whitted {
+
+void Accelerator::intersect(std::span<const Ray> rays, RayKind kind, std::span<Hit> hits) const {
+    RT_CHECK_EQ(rays.size(), hits.size());
+    for (size_t i = 0; i < rays.size(); ++i) hits[i] = intersect(rays[i], kind);
+}
+
+}  // namespace whitted

@@ -1,0 +1,58 @@
+// Importers turn files into a validated, plain Scene or throw one whitted::Error naming the file
+// and the problem (with a JSON pointer such as /accessors/3 where one applies).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "scene/environment.h"
+#include "scene/scene.h"
+
+namespace whitted {
+
+struct ImportOptions {
+    int scene_index = -1;                       ///< glTF scene to load; -1 = the file's default (or 0)
+    size_t max_memory = size_t(8) << 30;        ///< bytes the imported data may take before it is refused
+    bool add_default_light = true;              ///< a scene without lights gets the documented default
+    bool add_default_camera = true;             ///< a scene without cameras gets one framing its bounds
+    bool load_textures = true;                  ///< false: skip image decoding (faster `info`)
+    bool allow_outside_uris = false;            ///< external URIs may leave the file's folder ("../");
+                                                ///< absolute and file:// URIs are refused either way
+    // The environment (docs/environment.md): what rays that leave the scene see, and its light.
+    std::string environment;                    ///< lat-long map (file or bundled name) replacing the scene's;
+                                                ///< empty = the scene file's, if any
+    std::optional<float> environment_rotation;  ///< degrees about +Y; unset = the scene file's (or 0)
+    std::optional<float> environment_exposure;  ///< stops; unset = the scene file's (or 0)
+    bool no_environment = false;                ///< no environment at all, whatever the file says
+    bool default_environment = true;            ///< a glTF file with no lights and no environment is lit
+                                                ///< by the bundled studio map instead of the default light
+    int environment_lights = kDefaultEnvironmentLights;  ///< lights extracted from it (0 = all of its light is ambient)
+};
+
+/// Sets up the scene's environment after import: the one `options` names replaces the file's
+/// (rotation and exposure overrides apply to either), then its light is split into directional
+/// lights (appended to scene.lights, replacing the default light) and the SH ambient. Throws
+/// whitted::Error for a map that cannot be read.
+void setup_environment(Scene& scene, const ImportOptions& options);
+
+/// Every option the imported scene depends on, by name (as describe_image_settings for the
+/// render settings): what checkpoints and tile-job parts record.
+std::vector<std::pair<std::string, std::string>> describe_import_options(const ImportOptions& options);
+
+/// Loads a scene, dispatching on the extension: .gltf, .glb (import_gltf), .json (the scene file,
+/// import_scene_file in src/importers/scene_file.h).
+Scene load_scene(const std::string& path, const ImportOptions& options = {});
+
+/// glTF 2.0 (.gltf with external or data-URI resources, .glb).
+Scene import_gltf(const std::string& path, const ImportOptions& options = {});
+
+/// glTF 2.0 from bytes in memory (JSON, or GLB when `path` ends in .glb or the bytes start with
+/// the GLB magic). `path` names the source in errors; its folder anchors relative URIs.
+Scene import_gltf_memory(std::span<const uint8_t> bytes, const std::string& path, const ImportOptions& options = {});
+
+}  // namespace whitted
