@@ -1,7 +1,7 @@
 // `whitted bench process`: complete runs, process start to file written (docs/performance.md,
 // "Whole-process benchmark").
 //
-// Each measurement spawns this executable (`/proc/self/exe`, or --exe) as a user would run it, `whitted
+// Each measurement spawns the `whitted` beside this program (or --exe) as a user would run it, `whitted
 // render SCENE --width W --height H -o OUT`, and times it from spawn to exit (wall clock), with
 // its peak resident memory (wait4's rusage). The run's own summary line gives the split: load,
 // build, render and write; what is left of the wall time is start-up and exit (dynamic loading,
@@ -55,6 +55,14 @@ std::vector<std::string> default_scenes() {
             a + "scenes/default.glb", a + "gltf/Box/glTF-Binary/Box.glb"};
 }
 
+/// The `whitted` program in the folder of this one (whitted-bench, which `whitted bench` runs).
+std::string whitted_beside_this_program() {
+    std::error_code ec;
+    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+    if (ec) throw Error("bench process: cannot find this program (/proc/self/exe); give --exe");
+    return (self.parent_path() / "whitted").string();
+}
+
 /// The options with the lists split.
 struct BenchProcess {
     const BenchProcessOptions& options;
@@ -63,7 +71,7 @@ struct BenchProcess {
     const int& repeat = options.repeat;
     const int& threads = options.threads;
     const std::string& out = options.out;
-    std::string exe = options.exe.empty() ? std::string("/proc/self/exe") : options.exe;
+    std::string exe = options.exe.empty() ? whitted_beside_this_program() : options.exe;
 };
 
 /// One complete run: wall time, peak RSS, exit status and what it printed on stderr.
@@ -270,7 +278,7 @@ Command register_bench_process(CLI::App& bench) {
         ->check(CLI::Range(0, 1024))
         ->capture_default_str();
     app->add_option("--out", o->out, "Output directory: process.csv")->capture_default_str();
-    app->add_option("--exe", o->exe, "The whitted executable to time (default: this one; another build for a before/after)")
+    app->add_option("--exe", o->exe, "The whitted executable to time (default: the one beside this program; another build for a before/after)")
         ->check(CLI::ExistingFile);
     return Command{app, [o] { return run_bench_process(*o); }};
 }

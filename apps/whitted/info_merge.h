@@ -1,11 +1,9 @@
 // `whitted info` (what the importer made of a file) and `whitted merge` (tile-job parts into
-// their frame).
+// their frame): what their flags parse into (flags.h), and the runs.
 #pragma once
 
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 #include "importers/scene_loader.h"
 #include "output/image_output.h"
@@ -24,9 +22,6 @@ struct MergeCommand {
     OutputSettings out;
     bool exr_half = false;           ///< --exr-half: a half-float beauty whatever the parts hold
 };
-
-CLI::App* add_info_command(CLI::App& app, InfoCommand& c);
-CLI::App* add_merge_command(CLI::App& app, MergeCommand& c);
 
 /// Prints the scene's description (describe_scene) on stdout; returns the exit code.
 int run_info(const InfoCommand& c);

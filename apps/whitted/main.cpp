@@ -1,24 +1,28 @@
 // whitted: the command-line front end. Each command parses its flags into the library's settings
-// and calls the library: `render` (render_command.h), `info` and `merge` (info_merge.h), and the
-// `bench` commands of benchmarks/ (bench_commands.h).
+// (flags.h) and calls the library: `render` (render_command.h), `info` and `merge` (info_merge.h).
+// `whitted bench ...` runs the whitted-bench program beside this one (apps/whitted-bench: the
+// commands of benchmarks/), so that the renderer builds without them.
 //
 // Errors from bad input or bad flags end in exactly one line on stderr and a non-zero exit code:
 // 2 for command-line errors, 1 for everything else.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "benchmarks/bench_commands.h"
+#include <unistd.h>
+
 #include "core/error.h"
 #include "core/huge_pages.h"
 #include "core/log.h"
-#include "info_merge.h"
+#include "flags.h"
 #include "interrupt.h"
-#include "render_command.h"
 #include "session/mpi_frame.h"
 
 namespace {
@@ -44,7 +48,6 @@ struct Commands {
     CLI::App* render_app = nullptr;
     CLI::App* info_app = nullptr;
     CLI::App* merge_app = nullptr;
-    std::vector<app::Command> bench;
 };
 
 /// Builds the command line: global options, render, info, merge and bench <name>.
@@ -58,21 +61,33 @@ void add_commands(CLI::App& app, Commands& c) {
     c.info_app = add_info_command(app, c.info);
     c.merge_app = add_merge_command(app, c.merge);
 
-    // whitted bench <name>: benchmarks print figures and write CSV/plots (docs/performance.md).
-    CLI::App* bench = app.add_subcommand("bench", "Benchmarks: print figures, write CSV and plots");
-    bench->require_subcommand(1);
-    // Each benchmark module registers itself here (one line each; benchmarks/bench_commands.h):
-    c.bench.push_back(app::register_bench_aa(*bench));
-    c.bench.push_back(app::register_bench_accel(*bench));
-    c.bench.push_back(app::register_bench_env(*bench));
-    c.bench.push_back(app::register_bench_process(*bench));
-    c.bench.push_back(app::register_bench_scale(*bench));
-    c.bench.push_back(app::register_bench_skip(*bench));
-    c.bench.push_back(app::register_bench_stability(*bench));
+    // Listed for --help only: run_bench_program() hands `bench` to whitted-bench before parsing.
+    app.add_subcommand("bench", "Benchmarks: print figures, write CSV and plots (the whitted-bench program; "
+                                "docs/performance.md)");
 
     // Global options (--log-level) may also follow the subcommand.
-    for (CLI::App* sub : {c.render_app, c.info_app, c.merge_app, bench}) sub->fallthrough();
-    for (app::Command& b : c.bench) b.app->fallthrough();
+    for (CLI::App* sub : {c.render_app, c.info_app, c.merge_app}) sub->fallthrough();
+}
+
+/// `whitted [--log-level L] bench ...`: replaces this process by whitted-bench, beside this program,
+/// with the same arguments; nothing when the command is another. Returns the exit code when
+/// whitted-bench cannot run (not built, say).
+std::optional<int> run_bench_program(int argc, char** argv) {
+    int i = 1;
+    while (i < argc && std::strncmp(argv[i], "--log-level", 11) == 0) i += std::strchr(argv[i], '=') ? 1 : 2;
+    if (i >= argc || std::strcmp(argv[i], "bench") != 0) return std::nullopt;
+    std::error_code ec;
+    const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec).parent_path() / "whitted-bench";
+    if (ec || !std::filesystem::exists(exe)) {
+        std::fprintf(stderr, "whitted: error: bench: %s is not built (the bench commands are their own program: "
+                     "cmake --build build/release --target whitted-bench, or bash scripts/dev test)\n", exe.c_str());
+        return 1;
+    }
+    std::vector<char*> args(argv, argv + argc + 1);
+    args[0] = const_cast<char*>(exe.c_str());
+    ::execv(exe.c_str(), args.data());
+    std::fprintf(stderr, "whitted: error: bench: cannot run %s: %s\n", exe.c_str(), std::strerror(errno));
+    return 1;
 }
 
 /// Parses the command line; returns the exit code when the run ends here (help, version, a bad flag).
@@ -112,8 +127,6 @@ int run(Commands& c, const std::string& cmdline) {
     }
     if (c.info_app->parsed()) return run_info(c.info);
     if (c.merge_app->parsed()) return run_merge(c.merge, cmdline);
-    for (app::Command& b : c.bench)
-        if (b.app->parsed()) return b.run();
     return 0;
 }
 
@@ -123,6 +136,7 @@ int main(int argc, char** argv) {
     // Big buffers (images, environment maps, accelerators) fault in 2 MiB pages: on the machines
     // measured, page faults were half the time of a small run (docs/performance.md).
     restart_with_huge_pages(argv);
+    if (const std::optional<int> failed = run_bench_program(argc, argv)) return *failed;
     // Under an MPI launcher (mpirun -n N whitted render ...): MPI for the process's life; a plain
     // run never initialises it (docs/distributed.md).
     std::optional<MpiSession> mpi;

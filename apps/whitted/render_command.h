@@ -1,10 +1,8 @@
-// `whitted render`: the flags, in option groups by task, parsed into the library's settings, and
-// the run: load, configure, render the frame (tiles, checkpoints, MPI ranks), write, summarise.
+// `whitted render`: what its flags parse into (flags.h), and the run: load, configure, render the
+// frame (tiles, checkpoints, MPI ranks), write, summarise.
 #pragma once
 
 #include <string>
-
-#include <CLI/CLI.hpp>
 
 #include "importers/scene_loader.h"
 #include "integrator/render_settings.h"
@@ -34,16 +32,6 @@ struct RenderCommand {
     std::string tile_log;                       ///< CSV of per-tile times (docs/measurements/distributed.md)
     TileOrder tile_order = TileOrder::Auto;
 };
-
-/// Adds `render` to `app` with every flag writing into `c`.
-CLI::App* add_render_command(CLI::App& app, RenderCommand& c);
-
-/// The environment flags (docs/environment.md), shared by `render` and `info`, added to `group`
-/// (an option group of either).
-void add_environment_options(CLI::App* group, ImportOptions& io);
-/// The output flags (colour pipeline, bits, EXR and TIFF encoding), shared by `render` and `merge`,
-/// in the "Output" group.
-CLI::App* add_output_options(CLI::App* app, OutputSettings& out);
 
 /// Runs `whitted render`: `given` tells which settings a flag set (they win over the scene file's);
 /// `mpi` is the process's MPI session (null in a plain run). Returns the exit code.

@@ -211,6 +211,26 @@ TEST(Cli, SharedSamplesAreTracedOnceForAnyTileSizeAndThreads) {
     fs::remove(out);
 }
 
+// `whitted bench ...` runs the whitted-bench program beside whitted, with the same arguments (global
+// options before `bench` included); where it is not built, one line says so.
+TEST(Cli, BenchRunsTheBenchProgramBesideIt) {
+    Result r = run("--log-level error bench --help");
+    EXPECT_EQ(r.code, 0) << r.err;
+    for (const char* name : {"accel", "aa", "env", "process", "scale", "skip", "stability"})
+        EXPECT_NE(r.out.find(name), std::string::npos) << name << "\n" << r.out;
+    r = run("--help");
+    EXPECT_NE(r.out.find("bench"), std::string::npos) << r.out;
+    const fs::path dir = whitted::test::scratch_dir("whitted_cli", "alone");
+    const fs::path alone = dir / "whitted";
+    fs::copy_file(WHITTED_EXE, alone, fs::copy_options::overwrite_existing);
+    r = whitted::test::run_program(alone.string(), "bench accel --help");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("whitted-bench"), std::string::npos) << r.err;
+    r = whitted::test::run_program(alone.string(), "info '" + kBox + "'");  // the rest works without it
+    EXPECT_EQ(r.code, 0) << r.err;
+}
+
 // `render --help` shows the flags in groups by task, measurement knobs under Diagnostics.
 TEST(Cli, HelpGroupsFlagsByTask) {
     const Result r = run("render --help");
