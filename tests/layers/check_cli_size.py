@@ -10,6 +10,8 @@ import re
 import sys
 import tempfile
 
+from check_layers import run_checker
+
 MAX_MAIN_LINES = 300
 MAX_FUNCTION_LINES = 60
 # A function definition's first line: a return type or scope, a name, "(" and no ";" (not a call
@@ -75,17 +77,8 @@ def self_test():
 
 
 def main():
-    if sys.argv[1:] == ["--self-test"]:
-        return self_test()
-    if len(sys.argv) != 2:
-        print(__doc__, file=sys.stderr)
-        return 2
-    problems = check(sys.argv[1])
-    for p in problems:
-        print(p)
-    if not problems:
-        print(f"apps/whitted: main.cpp within {MAX_MAIN_LINES} lines, every function within {MAX_FUNCTION_LINES}")
-    return 1 if problems else 0
+    return run_checker(check, self_test, __doc__,
+                       f"apps/whitted: main.cpp within {MAX_MAIN_LINES} lines, every function within {MAX_FUNCTION_LINES}")
 
 
 if __name__ == "__main__":

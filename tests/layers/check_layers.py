@@ -134,18 +134,24 @@ def self_test():
     return 1 if failed else 0
 
 
-def main():
+def run_checker(check, self_test, doc, ok_line):
+    """The command line of a checker: ROOT (print each problem, exit 1 if any) or --self-test."""
     if sys.argv[1:] == ["--self-test"]:
         return self_test()
     if len(sys.argv) != 2:
-        print(__doc__, file=sys.stderr)
+        print(doc, file=sys.stderr)
         return 2
     problems = check(sys.argv[1])
     for p in problems:
         print(p)
     if not problems:
-        print(f"layers: {' -> '.join(LAYERS)}; no include goes up, no cycle")
+        print(ok_line)
     return 1 if problems else 0
+
+
+def main():
+    return run_checker(check, self_test, __doc__,
+                       f"layers: {' -> '.join(LAYERS)}; no include goes up, no cycle")
 
 
 if __name__ == "__main__":

@@ -45,15 +45,20 @@ Scene glass_and_shadows_scene() {
     return s;
 }
 
-Film render(const Scene& s, int threads, int tile, const AaSettings& aa = {}, RenderStats* stats = nullptr) {
+/// The tests' settings: 97 x 61 (odd on purpose: no tile size below divides it), with `aa`.
+RenderSettings settings(int threads, int tile, const AaSettings& aa, bool aovs = true) {
     RenderSettings rs;
-    rs.width = 97;  // odd on purpose: no tile size below divides it
+    rs.width = 97;
     rs.height = 61;
     rs.threads = threads;
     rs.tile_size = tile;
-    rs.aovs = AovSet{true, true, true, true, true, true};
+    if (aovs) rs.aovs = AovSet{true, true, true, true, true, true};
     rs.aa = aa;
-    Renderer r(s, rs);
+    return rs;
+}
+
+Film render(const Scene& s, int threads, int tile, const AaSettings& aa = {}, RenderStats* stats = nullptr) {
+    Renderer r(s, settings(threads, tile, aa));
     return r.render(stats);
 }
 
@@ -129,13 +134,7 @@ TEST(Determinism, TilesRenderedAloneInAnyOrderMakeTheSameImage) {
         RenderStats ref_stats;
         const Film reference = render(s, 1, 32, aa, &ref_stats);
         for (auto [threads, tile] : {std::pair{2, 7}, std::pair{3, 16}, std::pair{1, 200}}) {
-            RenderSettings rs;
-            rs.width = 97;
-            rs.height = 61;
-            rs.threads = threads;
-            rs.tile_size = tile;
-            rs.aovs = AovSet{true, true, true, true, true, true};
-            rs.aa = aa;
+            const RenderSettings rs = settings(threads, tile, aa);
             const Renderer r(s, rs);
             const size_t n = r.tiles().size();
             std::vector<size_t> order(n);
@@ -165,12 +164,7 @@ TEST(Determinism, SomeTilesTraceOnlyTheirOwnCorners) {
     AaSettings aa;
     aa.mode = AaMode::Corners;
     const Film reference = render(s, 1, 32, aa);
-    RenderSettings rs;
-    rs.width = 97;
-    rs.height = 61;
-    rs.threads = 3;
-    rs.tile_size = 10;
-    rs.aa = aa;
+    const RenderSettings rs = settings(3, 10, aa, false);
     const Renderer r(s, rs);
     const std::vector<TileRect> tiles = r.tiles();
     std::vector<size_t> mine;
@@ -197,12 +191,7 @@ TEST(Determinism, EveryAaModeCropsToTheSamePixels) {
     const Scene s = glass_and_shadows_scene();
     for (const AaSettings& aa : all_aa_modes()) {
         const Film full = render(s, 2, 16, aa);
-        RenderSettings rs;
-        rs.width = 97;
-        rs.height = 61;
-        rs.threads = 2;
-        rs.tile_size = 9;
-        rs.aa = aa;
+        RenderSettings rs = settings(2, 9, aa, false);
         rs.crop = PixelWindow{10, 5, 60, 40};
         const Film crop = Renderer(s, rs).render();
         for (int y = 5; y < 40; ++y)
