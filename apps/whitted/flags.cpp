@@ -149,6 +149,31 @@ void add_distributed(CLI::App* render, RenderCommand& c) {
     g->add_option("--checkpoint-file", c.checkpoint_file, "Checkpoint path (default: the output path + .checkpoint.exr)");
 }
 
+/// Animation: the moment of an animated glTF file (docs/gltf-support.md "Animation"), for `render` and `info`.
+CLI::App* add_animation_options(CLI::App* app, ImportOptions& io) {
+    CLI::App* g = app->add_option_group("Animation", "The moment an animated glTF file is posed at, or a sequence");
+    g->add_option_function<double>(
+         "--time", [&io](const double& t) { check_animation_time(t, "--time"); io.time = t; },
+         "Seconds into the animations (before the first key: the first value; after the last: the last)")
+        ->default_str("0");
+    g->add_option("--animation", io.animation, "Animations applied: all, a name, or indices (0,2)")
+        ->capture_default_str();
+    g->add_flag("--loop", io.loop, "Each animation repeats after its duration instead of holding its last key");
+    return g;
+}
+
+/// render's sequence flags, in the Animation group.
+void add_sequence_options(CLI::App* group, RenderCommand& c) {
+    group->add_option("--frames", c.frames,
+                      "Render frames A-B as an image sequence: frame k at --time k/fps, written to the output name "
+                      "with its '#' run replaced by k (out_####.exr -> out_0000.exr ...)");
+    group->add_option("--fps", c.fps, "Frames per second of --frames")->check(CLI::PositiveNumber)->capture_default_str();
+    group->add_option("--orbit", c.orbit,
+                      "With --frames: the default camera turns this many degrees about the up axis over the sequence "
+                      "(a turntable)")
+        ->capture_default_str();
+}
+
 /// Diagnostics: measurement knobs and what the run shows of itself.
 void add_diagnostics(CLI::App* render, RenderCommand& c) {
     CLI::App* g = render->add_option_group("Diagnostics", "Measurement knobs and progress");
@@ -221,6 +246,7 @@ CLI::App* add_info_command(CLI::App& app, InfoCommand& c) {
                    "List every light extracted from the environment (by default: their count, share and the "
                    "brightest few)");
     add_environment_options(info->add_option_group("Lighting", "The environment (docs/environment.md)"), c.import);
+    add_animation_options(info, c.import);
     return info;
 }
 
@@ -243,6 +269,7 @@ CLI::App* add_render_command(CLI::App& app, RenderCommand& c) {
     add_render_output(render, c);
     add_sampling(render, c.render);
     add_lighting(render, c);
+    add_sequence_options(add_animation_options(render, c.import), c);
     add_acceleration(render, c);
     add_distributed(render, c);
     add_diagnostics(render, c);

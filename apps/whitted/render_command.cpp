@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -18,6 +19,7 @@
 #include "integrator/render.h"
 #include "interrupt.h"
 #include "session/mpi_frame.h"
+#include "session/sequence.h"
 #include "session/tile_job.h"
 
 namespace whitted::cli {
@@ -84,9 +86,10 @@ void apply_tile_job(RenderCommand& c, const Scene& scene, const SettingList& ide
     c.out.exr_half = false;  // exact: the merged frame is bit-identical to a one-piece render
 }
 
-/// Loads the scene, lets its settings fill what the flags did not set, checks the colour pipeline
-/// and builds the renderer.
-void prepare(RenderCommand& c, const SettingGiven& given, Prepared& p) {
+/// Loads the scene, lets its settings fill what the flags did not set, checks the colour pipeline,
+/// lets `adjust` change the scene (a sequence's camera) and builds the renderer.
+void prepare(RenderCommand& c, const SettingGiven& given, Prepared& p,
+             const std::function<void(Scene&, const RenderSettings&)>& adjust = {}) {
     RenderSettings& rs = c.render;
     const auto t_load = Clock::now();
     c.import.max_memory = size_t(c.max_memory_gb * double(size_t(1) << 30));
@@ -106,6 +109,7 @@ void prepare(RenderCommand& c, const SettingGiven& given, Prepared& p) {
     for (auto& kv : describe_import_options(c.import)) p.identity.push_back(kv);
     for (auto& kv : describe_image_settings(rs)) p.identity.push_back(kv);
     if (!c.tile_job.empty()) apply_tile_job(c, p.scene, p.identity);
+    if (adjust) adjust(p.scene, rs);
     p.renderer = std::make_unique<Renderer>(p.scene, rs);
 }
 
@@ -223,11 +227,13 @@ int write_frame(RenderCommand& c, const Prepared& p, const FrameResult& frame, c
     write_image(frame.film, c.output, c.out);
     signals.writing.store(false);
     if (!missing.empty()) {
+        const std::string resume = fo.checkpoint_path.empty()
+                                       ? std::string(" (a sequence keeps no checkpoint)")
+                                       : " and the checkpoint " + fo.checkpoint_path + "; continue with --resume";
         std::fprintf(stderr,
                      "whitted: interrupted: wrote %s with %zu of %zu tiles (the missing ones are 0 and listed in its "
-                     "metadata) and the checkpoint %s; continue with --resume\n",
-                     c.output.c_str(), frame.tiles.size() - missing.size(), frame.tiles.size(),
-                     fo.checkpoint_path.c_str());
+                     "metadata)%s\n",
+                     c.output.c_str(), frame.tiles.size() - missing.size(), frame.tiles.size(), resume.c_str());
         return 128 + signals.last_signal.load();
     }
     std::error_code ec;
@@ -240,9 +246,63 @@ int write_frame(RenderCommand& c, const Prepared& p, const FrameResult& frame, c
     return 0;
 }
 
+/// The bounds of every frame of a sequence when its camera is the default one (which then frames
+/// them all and stays fixed), else nothing: each frame loaded without textures or environment.
+std::optional<Bounds3d> sequence_bounds(const RenderCommand& c, const SettingGiven& given, const FrameRange& range) {
+    std::optional<Bounds3d> all;
+    for (int k = range.first; k <= range.last; ++k) {
+        ImportOptions io = c.import;
+        io.time = frame_time(k, range.fps);
+        io.load_textures = false;
+        io.no_environment = true;
+        const Scene scene = load_scene(c.input, io);
+        RenderSettings rs = c.render;
+        apply_scene_settings(scene.settings, rs, given);
+        if (rs.camera < 0 || size_t(rs.camera) >= scene.cameras.size() || !scene.cameras[size_t(rs.camera)].is_default)
+            return std::nullopt;
+        if (!all) all = Bounds3d{};
+        all->extend(scene.world_bounds());
+    }
+    return all;
+}
+
+/// `render --frames A-B`: every frame rendered and written like a single image, at time k / fps.
+int run_sequence(const RenderCommand& c0, const std::string& cmdline, const SettingGiven& given, MpiSession* mpi) {
+    FrameRange range = parse_frame_range(c0.frames);
+    range.fps = c0.fps;
+    (void)frame_path(c0.output, range.first);  // an output name without '#' fails before anything is done
+    if (mpi && mpi->size() > 1)
+        throw Error("--frames under mpirun is not supported yet: render the frames as separate runs");
+    if (!c0.tile_job.empty() || c0.resume || c0.checkpoint_seconds > 0)
+        throw Error("--frames: --tile-job, --checkpoint and --resume apply to one image, not to a sequence");
+    install_interrupt_handlers();
+    const std::optional<Bounds3d> bounds = sequence_bounds(c0, given, range);
+    if (c0.orbit != 0.0 && !bounds) log_warning("--orbit turns the default camera only: the file's camera is used");
+    for (int k = range.first; k <= range.last; ++k) {
+        if (interrupts().signals.load() > 0) return 128 + interrupts().last_signal.load();
+        RenderCommand c = c0;
+        c.import.time = frame_time(k, range.fps);
+        c.output = frame_path(c0.output, k);
+        const double turn = c0.orbit * double(k - range.first) / double(range.count());
+        Prepared p;
+        prepare(c, given, p, [&](Scene& scene, const RenderSettings& rs) {
+            if (bounds) scene.cameras[size_t(rs.camera)] = default_camera(*bounds, turn);
+        });
+        if (k == range.first) log_scene(c, p.scene, *p.renderer);
+        FrameOptions fo = frame_options(c, p.identity, *p.renderer);
+        fo.checkpoint_path.clear();  // a sequence keeps no checkpoint
+        const FrameResult frame = render_tiles(c, fo, *p.renderer, nullptr);
+        if (const int code = write_frame(c, p, frame, fo, cmdline); code != 0) return code;
+    }
+    std::fprintf(stderr, "whitted: wrote %d frames, %s to %s\n", range.count(), frame_path(c0.output, range.first).c_str(),
+                 frame_path(c0.output, range.last).c_str());
+    return 0;
+}
+
 }  // namespace
 
 int run_render(RenderCommand c, const std::string& cmdline, const SettingGiven& given, MpiSession* mpi) {
+    if (!c.frames.empty()) return run_sequence(c, cmdline, given, mpi);
     const bool root = !mpi || mpi->rank() == 0;
     if (root) install_interrupt_handlers();
     else ignore_interrupts();  // mpirun passes signals on to every rank: rank 0 decides

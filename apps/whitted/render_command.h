@@ -31,6 +31,9 @@ struct RenderCommand {
     std::string checkpoint_file;                ///< empty: beside the output (checkpoint_path_for)
     std::string tile_log;                       ///< CSV of per-tile times (docs/measurements/distributed.md)
     TileOrder tile_order = TileOrder::Auto;
+    std::string frames;                         ///< "A-B": an image sequence (session/sequence.h); empty: one image
+    double fps = 24.0;                          ///< frames per second of the sequence: frame k at time k / fps
+    double orbit = 0.0;                         ///< degrees the default camera turns about +Y over the sequence
 };
 
 /// Runs `whitted render`: `given` tells which settings a flag set (they win over the scene file's);

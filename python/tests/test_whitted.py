@@ -201,3 +201,18 @@ def test_import_render_and_png_do_not_load_openimageio(tmp_path):
                          env=dict(os.environ), check=True).stdout.split()
     assert out == ["False", "True"]
     assert all((tmp_path / ("a." + ext)).stat().st_size > 0 for ext in ("png", "exr", "jpg", "tif"))
+
+
+def test_load_poses_an_animated_file_at_a_time():
+    # AnimatedTriangle turns about +Z over one second: a quarter turn at 0.25 s moves the image.
+    tri = os.path.join(ASSETS, "gltf", "AnimatedTriangle", "glTF", "AnimatedTriangle.gltf")
+    at0 = whitted.render(whitted.load(tri, default_camera=True), width=32, height=32).beauty
+    at = whitted.render(whitted.load(tri, time=0.25), width=32, height=32).beauty
+    assert not np.array_equal(at0, at)
+    again = whitted.render(whitted.load(tri, time=0.25, animation="0"), width=32, height=32).beauty
+    assert np.array_equal(at, again)
+    assert "time=0.25s" in whitted.load(tri, time=0.25).info()["text"]
+    with pytest.raises(whitted.Error, match="no animation 'walk'"):
+        whitted.load(tri, animation="walk")
+    with pytest.raises(whitted.Error, match="time"):
+        whitted.load(tri, time=float("nan"))

@@ -96,7 +96,7 @@ inline double to_raw(T c) {
 template <typename T, bool Raw, typename Visitor>
 void visit_typed(const AccessorData& a, Visitor&& visit) {
     using Out = std::conditional_t<Raw, double, float>;
-    Out v[4] = {0, 0, 0, 0};
+    Out v[16] = {};  // up to MAT4 (skins' inverse bind matrices)
     const int n = a.components;
     auto decode = [&](const uint8_t* p) {
         for (int c = 0; c < n; ++c) {

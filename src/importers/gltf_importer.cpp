@@ -32,6 +32,7 @@
 
 #include "importers/file_bytes.h"
 #include "importers/gltf_accessor.h"
+#include "importers/gltf_animation.h"
 #include "importers/gltf_extensions.h"
 #include "importers/gltf_json.h"
 #include "importers/gltf_compressed.h"
@@ -367,25 +368,6 @@ std::string one_line(std::string s) {
 // ---------------------------------------------------------------------------------------------
 // Small helpers
 
-Mat4d node_local_transform(const tinygltf::Node& node) {
-    if (node.matrix.size() == 16) {
-        Mat4d m;  // glTF stores column-major
-        for (int c = 0; c < 4; ++c)
-            for (int r = 0; r < 4; ++r) m(r, c) = node.matrix[size_t(c * 4 + r)];
-        return m;
-    }
-    Mat4d m;
-    if (node.translation.size() == 3)
-        m = Mat4d::translate({node.translation[0], node.translation[1], node.translation[2]});
-    if (node.rotation.size() == 4) {
-        const auto& q = node.rotation;
-        const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-        m = m * Mat4d::rotate(q[0] / n, q[1] / n, q[2] / n, q[3] / n);
-    }
-    if (node.scale.size() == 3) m = m * Mat4d::scale({node.scale[0], node.scale[1], node.scale[2]});
-    return m;
-}
-
 std::string node_label(const tinygltf::Model& model, int node) {
     const std::string& n = model.nodes[size_t(node)].name;
     return n.empty() ? fmt::format("node {}", node) : n;
@@ -398,8 +380,9 @@ std::string node_label(const tinygltf::Model& model, int node) {
 struct MeshKey {
     int mesh, primitive;
     bool mirrored;
+    int node = -1;  ///< the node whose pose deforms the mesh (skin, morph targets); -1: not deformed
     bool operator<(const MeshKey& o) const {
-        return std::tie(mesh, primitive, mirrored) < std::tie(o.mesh, o.primitive, o.mirrored);
+        return std::tie(mesh, primitive, mirrored, node) < std::tie(o.mesh, o.primitive, o.mirrored, o.node);
     }
 };
 
@@ -415,11 +398,13 @@ public:
         check_images_present();
         classify_extensions();
         convert_materials();
+        pose();
         traverse_scene();
         check_memory();
         build_meshes();
         decode_textures();
         add_defaults();
+        describe_animation(m_model, m_animations, m_scene);
         m_warnings.flush_to(m_scene);
         return std::move(m_scene);
     }
@@ -500,6 +485,10 @@ private:
         } catch (const std::exception& e) {
             fail("", "glTF parse error: {}", one_line(e.what()));
         }
+        // tinygltf 2.7 reports a skin without inverseBindMatrices as an error, though glTF 2.0
+        // (3.7.3) makes them optional (identity matrices); it parses the skin all the same (-1).
+        const std::string no_inverse_bind = "'inverseBindMatrices' property is missing in Skin.\n";
+        for (size_t at; (at = err.find(no_inverse_bind)) != std::string::npos;) err.erase(at, no_inverse_bind.size());
         // Refusals by the URI policy or the image header check explain a failure better than tinygltf.
         if (!m_uri_policy.refused.empty()) fail("", "{}", m_uri_policy.refused);
         if (!m_loader.refused.empty()) {
@@ -594,13 +583,14 @@ private:
             if (policy.support == ExtensionSupport::Ignored)
                 m_warnings.add("ext:" + name, fmt::format("extension {} ignored: {}", name, policy.note));
         }
-        if (!m_model.skins.empty() || !m_model.animations.empty())
-            m_warnings.add("skins",
-                           "skins and animations are ignored: rendered in bind pose / first frame "
-                           "(node transforms as stored)");
-        for (const tinygltf::Mesh& mesh : m_model.meshes)
-            for (const tinygltf::Primitive& p : mesh.primitives)
-                if (!p.targets.empty()) m_warnings.add("morph", "morph targets are ignored: base geometry rendered");
+    }
+
+    // ---- the pose ------------------------------------------------------------------------------
+    /// Every node's transform and morph weights at the chosen time (gltf_animation.h).
+    void pose() {
+        m_animations = choose_animations(m_model, m_path, m_options.animation);
+        m_pose = pose_nodes(m_model, m_path, m_animations, m_options.time, m_options.loop, m_warnings);
+        m_scene.time = m_options.time;
     }
 
     // ---- materials and texture references -----------------------------------------------------
@@ -821,8 +811,8 @@ private:
         return triangle_count_for_mode(p.mode, n) > 0;
     }
 
-    uint32_t mesh_for(int mesh, int primitive, bool mirrored) {
-        const MeshKey key{mesh, primitive, mirrored};
+    uint32_t mesh_for(int mesh, int primitive, bool mirrored, int node = -1) {
+        const MeshKey key{mesh, primitive, mirrored, node};
         auto [it, inserted] = m_mesh_map.emplace(key, uint32_t(m_requests.size()));
         if (inserted) m_requests.push_back(key);
         return it->second;
@@ -844,13 +834,16 @@ private:
     /// transform has a negative determinant.
     void place_mesh(int node, const std::string& label, int mesh, const Mat4d& world) {
         const auto& prims = m_model.meshes[size_t(mesh)].primitives;
-        const bool mirrored = world.det3() < 0;
+        // A skinned mesh is posed in world space by its joints: its node's transform does not apply.
+        const bool skinned = m_model.nodes[size_t(node)].skin >= 0;
+        const Mat4d& placed = skinned ? Mat4d::identity() : world;
+        const bool mirrored = placed.det3() < 0;
         for (size_t p = 0; p < prims.size(); ++p) {
             if (!renderable(prims[p])) continue;
             check_instance_budget(node, 1);
             Instance inst;
-            inst.mesh = mesh_for(mesh, int(p), mirrored);
-            inst.world_from_object = world;
+            inst.mesh = mesh_for(mesh, int(p), mirrored, deformed(m_model, node, int(p)) ? node : -1);
+            inst.world_from_object = placed;
             inst.node_name = label;
             inst.node = node;
             m_scene.instances.push_back(std::move(inst));
@@ -978,7 +971,7 @@ private:
             const Item item = stack.back();
             stack.pop_back();
             const tinygltf::Node& node = m_model.nodes[size_t(item.node)];
-            const Mat4d world = item.parent * node_local_transform(node);
+            const Mat4d world = item.parent * m_pose.local[size_t(item.node)];
             if (node.mesh >= 0) {
                 if (const tinygltf::Value* gi = find_extension(node.extensions, "EXT_mesh_gpu_instancing"))
                     place_gpu_instances(item.node, node.mesh, world, gi);
@@ -1206,6 +1199,11 @@ private:
             const tinygltf::Primitive& p = primitive(m_requests[i]);
             const int tangent_uv =
                 needs_tangents(p) ? int(m_scene.materials[size_t(p.material)].normal_texture.uv_set) : -1;
+            if (m_requests[i].node >= 0) {  // deformed by its node's pose: geometry of its own
+                source[i] = uint32_t(i);
+                unique.push_back(uint32_t(i));
+                continue;
+            }
             const auto [it, inserted] = decoded.emplace(GeometryKey{&p.attributes, p.indices, p.mode, tangent_uv},
                                                         uint32_t(i));
             source[i] = it->second;
@@ -1220,6 +1218,10 @@ private:
             const MeshKey& k = m_requests[unique[u]];
             const std::string ptr = fmt::format("/meshes/{}/primitives/{}", k.mesh, k.primitive);
             built[u] = build_geometry(primitive(k), ptr, logs[u]);
+            if (k.node >= 0) {
+                deform_mesh(built[u], m_model, m_path, k.node, k.primitive, m_pose);
+                if (!primitive(k).attributes.count("NORMAL")) built[u].normals = smooth_normals(built[u]);
+            }
             report_mesh_numbers(sanitize_mesh_numbers(built[u]), ptr, logs[u]);
             if (k.mirrored) mirror(built[u]);
         });
@@ -1339,6 +1341,8 @@ private:
     LoaderState m_loader;
     Scene m_scene;
     WarningLog m_warnings;
+    std::vector<int> m_animations;  ///< the animations posed (--animation)
+    GltfPose m_pose;                ///< every node at the chosen time
     std::map<std::pair<int, bool>, int32_t> m_texture_map;  ///< (glTF texture, sRGB) -> Scene texture
     std::map<MeshKey, uint32_t> m_mesh_map;                 ///< -> Scene mesh
     std::vector<MeshKey> m_requests;                        ///< Scene mesh -> what it is built from

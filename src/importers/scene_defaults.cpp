@@ -33,8 +33,7 @@ void add_default_light(Scene& scene, WarningLog& warnings) {
 
 /// Perspective camera on +Z, raised 15 degrees, looking at the bounds centre from far enough
 /// that the bounding sphere fits the vertical field of view with a 10% margin.
-void add_default_camera(Scene& scene, WarningLog& warnings) {
-    const Bounds3d b = scene.world_bounds();
+Camera default_camera(const Bounds3d& b, double orbit_degrees) {
     Vec3d center(0.0);
     double radius = 1.0;
     if (!b.empty()) {
@@ -44,7 +43,11 @@ void add_default_camera(Scene& scene, WarningLog& warnings) {
     }
     const double distance = radius / std::sin(kDefaultCameraYfov / 2) * kDefaultCameraMargin;
     const double elevation = 15.0 * std::numbers::pi / 180.0;
-    const Vec3d to_eye{0.0, std::sin(elevation), std::cos(elevation)};
+    Vec3d to_eye{0.0, std::sin(elevation), std::cos(elevation)};
+    if (orbit_degrees != 0.0) {  // turned about +Y through the centre
+        const double a = orbit_degrees * std::numbers::pi / 180.0;
+        to_eye = {std::sin(a) * to_eye.z, to_eye.y, std::cos(a) * to_eye.z};
+    }
     const Vec3d eye = center + to_eye * distance;
     // Camera frame: -Z looks at the centre, +X right, +Y up (glTF convention).
     const Vec3d z = to_eye;
@@ -64,7 +67,11 @@ void add_default_camera(Scene& scene, WarningLog& warnings) {
         c.world_from_camera(r, 3) = eye[r];
     }
     c.is_default = true;
-    scene.cameras.push_back(std::move(c));
+    return c;
+}
+
+void add_default_camera(Scene& scene, WarningLog& warnings) {
+    scene.cameras.push_back(default_camera(scene.world_bounds()));
     warnings.add("default-camera", "no cameras in the scene: added a default camera framing the bounds");
 }
 

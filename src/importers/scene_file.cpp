@@ -1014,7 +1014,8 @@ private:
     }
 
     void read_include(const Json& o, const std::string& ptr) {
-        check_object(o, ptr, "an include", {"file", "transform", "scene", "materials", "lights", "cameras", "comment"});
+        check_object(o, ptr, "an include",
+                     {"file", "transform", "scene", "materials", "lights", "cameras", "animation", "time_offset", "comment"});
         const std::string fp = sub(ptr, "file");
         const std::string file = string(require(o, "file", ptr, "an include", "a .gltf or .glb file name"), fp);
         const std::string ext = lower_ext(file);
@@ -1028,6 +1029,11 @@ private:
         sub_options.add_default_light = false;
         sub_options.scene_index = -1;
         if (const Json* s = member(o, "scene")) sub_options.scene_index = integer(*s, sub(ptr, "scene"), 0, INT32_MAX);
+        // Its animations: which, and at what time (the render's time plus the offset; glTF key
+        // times are not negative, so an earlier moment is the first key's).
+        if (const Json* a = member(o, "animation")) sub_options.animation = string(*a, sub(ptr, "animation"));
+        if (const Json* t = member(o, "time_offset"))
+            sub_options.time = std::max(0.0, m_options.time + number(*t, sub(ptr, "time_offset")));
         sub_options.max_memory = m_options.max_memory > m_bytes ? m_options.max_memory - m_bytes : 0;
         bool with_lights = true, with_cameras = true;
         if (const Json* l = member(o, "lights")) with_lights = boolean(*l, sub(ptr, "lights"));
@@ -1108,6 +1114,13 @@ private:
             else it->required = it->required || e.required;
         }
         for (const std::string& w : inc.warnings) m_scene.warn(fmt::format("{}: {}", file, w));
+        for (AnimationInfo& a : inc.animations) {
+            a.name = fmt::format("{}: {}", file, a.name);
+            m_scene.animations.push_back(std::move(a));
+        }
+        for (SkinInfo& k : inc.skins) m_scene.skins.push_back(std::move(k));
+        for (MorphInfo& m : inc.morphs) m_scene.morphs.push_back(std::move(m));
+        m_scene.time = m_options.time;
     }
 
     // ---- environment --------------------------------------------------------------------------

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "importers/environment_image.h"
@@ -27,7 +28,15 @@ std::vector<std::pair<std::string, std::string>> describe_import_options(const I
             {"env_exposure", num(o.environment_exposure)},
             {"no_environment", flag(o.no_environment)},
             {"default_environment", flag(o.default_environment)},
-            {"env_lights", std::to_string(o.environment_lights)}};
+            {"env_lights", std::to_string(o.environment_lights)},
+            {"time", fmt::format("{:.17g}", o.time)},
+            {"animation", o.animation},
+            {"loop", flag(o.loop)}};
+}
+
+void check_animation_time(double time, const std::string& what) {
+    if (!std::isfinite(time) || time < 0.0)
+        throw Error(fmt::format("{} {}: expected a finite number of seconds, 0 or more", what, time));
 }
 
 Scene load_scene(const std::string& path, const ImportOptions& options) {

@@ -32,7 +32,19 @@ struct ImportOptions {
     bool default_environment = true;            ///< a glTF file with no lights and no environment is lit
                                                 ///< by the bundled studio map instead of the default light
     int environment_lights = kDefaultEnvironmentLights;  ///< lights extracted from it (0 = all of its light is ambient)
+    // Animation (docs/gltf-support.md "Animation"): the moment a glTF file is posed at.
+    double time = 0.0;                          ///< seconds; finite, >= 0
+    std::string animation = "all";              ///< "all", a name, or indices "0,2": the animations applied
+    bool loop = false;                          ///< each animation repeats after its duration (else it holds its last key)
 };
+
+/// The default camera of a scene without one (docs/lights.md): perspective, looking at the centre
+/// of `bounds` from 15 degrees above, far enough to frame them; turned about +Y through the centre by
+/// `orbit_degrees` (a turntable).
+Camera default_camera(const Bounds3d& bounds, double orbit_degrees = 0.0);
+
+/// Throws whitted::Error unless `time` is a finite number of seconds >= 0 (`what` names it: "--time").
+void check_animation_time(double time, const std::string& what);
 
 /// Sets up the scene's environment after import: the one `options` names replaces the file's
 /// (rotation and exposure overrides apply to either), then its light is split into directional

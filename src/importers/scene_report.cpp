@@ -171,6 +171,30 @@ void describe_environment(const Scene& scene, ReportDetail detail, const std::fu
                          lights.size() - kBrightestEnvironmentLights));
 }
 
+/// What the file animates: its animations (the posed ones at scene.time), skins and morph targets.
+void describe_motion(const Scene& scene, const std::function<void(const std::string&)>& line) {
+    if (!scene.animations.empty()) line(fmt::format("pose: time={}s", num(scene.time)));
+    for (size_t i = 0; i < scene.animations.size(); ++i) {
+        const AnimationInfo& a = scene.animations[i];
+        line(fmt::format("animation[{}]: name=\"{}\" duration={}s channels={} interpolation={} posed={}", i, a.name,
+                         num(a.duration), a.channels, a.interpolations, yes_no(a.posed)));
+    }
+    for (size_t i = 0; i < scene.skins.size(); ++i) {
+        const SkinInfo& k = scene.skins[i];
+        line(fmt::format("skin[{}]: name=\"{}\" joints={} instances={}", i, k.name, k.joints, k.meshes));
+    }
+    for (size_t i = 0; i < scene.morphs.size(); ++i) {
+        const MorphInfo& m = scene.morphs[i];
+        std::string weights;
+        for (const float w : m.default_weights) {
+            if (!weights.empty()) weights += ',';
+            weights += num(w);
+        }
+        line(fmt::format("morph[{}]: mesh=\"{}\" targets={} default_weights={}", i, m.mesh, m.targets,
+                         weights.empty() ? "0" : weights));
+    }
+}
+
 }  // namespace
 
 std::string describe_scene(const Scene& scene, ReportDetail detail) {
@@ -221,6 +245,7 @@ std::string describe_scene(const Scene& scene, ReportDetail detail) {
         line(s);
     }
     if (scene.environment && scene.environment->image) describe_environment(scene, detail, line);
+    describe_motion(scene, line);
 
     for (size_t i = 0; i < scene.cameras.size(); ++i) {
         const Camera& c = scene.cameras[i];

@@ -304,6 +304,25 @@ inline std::string setting_flag(std::string_view key) {
     return flag;
 }
 
+/// What a glTF file animates, for `whitted info`: one record per animation, skin and morphed mesh.
+struct AnimationInfo {
+    std::string name;                 ///< the file's name, or "animation <i>"
+    float duration = 0.f;             ///< seconds: the last key time over its samplers
+    size_t channels = 0;
+    std::string interpolations;       ///< those its samplers use: "LINEAR", "STEP,CUBICSPLINE", ...
+    bool posed = false;               ///< chosen for this import (--animation) and applied at Scene::time
+};
+struct SkinInfo {
+    std::string name;                 ///< the file's name, or "skin <i>"
+    size_t joints = 0;
+    size_t meshes = 0;                ///< mesh instances it deforms in the imported scene
+};
+struct MorphInfo {
+    std::string mesh;                 ///< the mesh's name, or "mesh <i>"
+    size_t targets = 0;               ///< morph targets of each of its primitives
+    std::vector<float> default_weights;  ///< mesh.weights (empty: 0 each)
+};
+
 // ---------------------------------------------------------------------------------------------
 
 struct Scene {
@@ -321,6 +340,10 @@ struct Scene {
     std::vector<CompressedPrimitive> compressed;  ///< glTF primitives stored compressed
     std::vector<std::string> warnings;  ///< each distinct warning once
     SceneRenderSettings settings;     ///< from a scene file; empty for glTF
+    double time = 0.0;                ///< seconds: the moment the animated nodes, skins and morphs are posed at
+    std::vector<AnimationInfo> animations;  ///< the glTF file's animations (posed or not)
+    std::vector<SkinInfo> skins;
+    std::vector<MorphInfo> morphs;
 
     /// Geometry ids (see GeomKind): meshes, then spheres, then planes.
     uint32_t sphere_geom_id(size_t sphere) const { return uint32_t(meshes.size() + sphere); }

@@ -203,7 +203,9 @@ TEST(Cli, SharedSamplesAreTracedOnceForAnyTileSizeAndThreads) {
                                  " -o '" + out.string() + "'");
             ASSERT_EQ(r.code, 0) << r.err;
             const long long rays = camera_rays(r.err);
-            if (std::string(aa) == "corners") EXPECT_EQ(rays, 61 * 46) << tiling;
+            if (std::string(aa) == "corners") {
+                EXPECT_EQ(rays, 61 * 46) << tiling;
+            }
             if (first < 0) first = rays;
             EXPECT_EQ(rays, first) << aa << " " << tiling;
         }
@@ -258,6 +260,67 @@ TEST(Cli, InfoSummarisesEnvironmentLights) {
     ASSERT_EQ(v.code, 0) << v.err;
     EXPECT_NE(v.out.find("light[255]: "), std::string::npos) << v.out;
     EXPECT_GT(line_count(v.out), 256u);
+}
+
+// Animated glTF (docs/gltf-support.md "Animation"): --time and --animation choose the moment;
+// bad values are one line each, naming the flag or listing the animations the file has.
+TEST(Cli, AnimationTimeAndChoice) {
+    const std::string tri = std::string(WHITTED_ASSETS_DIR) + "/gltf/AnimatedTriangle/glTF/AnimatedTriangle.gltf";
+    Result r = run("info '" + tri + "' --time 0.5");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("pose: time=0.5s"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("animation[0]: name=\"animation 0\" duration=1s channels=1 interpolation=LINEAR posed=yes"),
+              std::string::npos) << r.out;
+    for (const char* bad : {"nan", "inf", "-1"}) {
+        r = run("render '" + tri + "' --time " + bad + " -o /dev/null.png");
+        EXPECT_NE(r.code, 0) << bad;
+        EXPECT_EQ(line_count(r.err), 1u) << r.err;
+        EXPECT_NE(r.err.find("--time"), std::string::npos) << r.err;
+    }
+    r = run("render '" + tri + "' --animation walk --no-progress -o /dev/null.png");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("no animation 'walk'"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("0 \"animation 0\""), std::string::npos) << r.err;  // the ones that exist
+}
+
+// --frames A-B renders frame k at exactly --time k/fps into the '#' run of the output name: each
+// frame bit for bit the separate render (here the scene file's own camera, so nothing else moves).
+// A static file with --orbit turns the default camera, the first frame being the plain render.
+TEST(Cli, FramesAreTheSeparateRenders) {
+    const fs::path dir = whitted::test::scratch_dir("whitted_cli", "frames");
+    const std::string tri = std::string(WHITTED_ASSETS_DIR) + "/gltf/AnimatedTriangle/glTF/AnimatedTriangle.gltf";
+    const fs::path scene = dir / "tri.json";
+    std::ofstream(scene) << R"({"version": 1, "camera": {"position": [0.5, 0.5, 3], "look_at": [0.5, 0.5, 0]},
+        "include": [{"file": ")" + tri + R"("}]})";
+    const std::string common = " --width 24 --height 24 --no-progress --exr-float";
+    Result r = run("render '" + scene.string() + "'" + common + " --frames 1-3 --fps 8 -o '" + (dir / "f_##.exr").string() + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (int k = 1; k <= 3; ++k) {
+        const fs::path frame = dir / ("f_0" + std::to_string(k) + ".exr");
+        ASSERT_TRUE(fs::exists(frame)) << frame;
+        char time[32];
+        std::snprintf(time, sizeof time, "%.17g", double(k) / 8.0);
+        r = run("render '" + scene.string() + "'" + common + " --time " + time + " -o '" + (dir / "one.exr").string() + "'");
+        ASSERT_EQ(r.code, 0) << r.err;
+        EXPECT_EQ(whitted::test::read_pixels(frame), whitted::test::read_pixels(dir / "one.exr")) << "frame " << k;
+    }
+    EXPECT_NE(whitted::test::read_pixels(dir / "f_01.exr"), whitted::test::read_pixels(dir / "f_03.exr"));
+    // A turntable of a static file: frame 0 is the plain render, the next ones turn.
+    r = run("render '" + kBox + "'" + common + " --frames 0-1 --orbit 90 -o '" + (dir / "t#.exr").string() + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    ASSERT_EQ(run("render '" + kBox + "'" + common + " -o '" + (dir / "plain.exr").string() + "'").code, 0);
+    EXPECT_EQ(whitted::test::read_pixels(dir / "t0.exr"), whitted::test::read_pixels(dir / "plain.exr"));
+    EXPECT_NE(whitted::test::read_pixels(dir / "t1.exr"), whitted::test::read_pixels(dir / "plain.exr"));
+    // No '#' in the name, or a bad range: one line, nothing written.
+    r = run("render '" + kBox + "'" + common + " --frames 0-1 -o '" + (dir / "nohash.exr").string() + "'");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("'#'"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "nohash.exr"));
+    r = run("render '" + kBox + "'" + common + " --frames 3-1 -o '" + (dir / "bad#.exr").string() + "'");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
 }
 
 TEST(Cli, InfoPrintsCounts) {

@@ -15,6 +15,14 @@
 #include "importers/scene_loader.h"
 #include "core/error.h"
 
+/// Each of v.x, v.y, v.z within eps of X, Y, Z (gtest EXPECT_NEAR each).
+#define EXPECT_VEC3_NEAR(v, X, Y, Z, eps) \
+    do {                                  \
+        EXPECT_NEAR((v).x, (X), (eps));   \
+        EXPECT_NEAR((v).y, (Y), (eps));   \
+        EXPECT_NEAR((v).z, (Z), (eps));   \
+    } while (0)
+
 namespace whitted::test {
 
 inline std::string asset(const std::string& relative) { return std::string(WHITTED_ASSETS_DIR) + "/gltf/" + relative; }

@@ -621,6 +621,32 @@ TEST(SceneFile, IncludeComposesTransformsAndRemapsIndices) {
     EXPECT_TRUE(s.lights[0].is_default);
 }
 
+// An include poses its glTF file at the render's time plus its time_offset, under its own animation
+// choice: the same instances as importing the file at that time; an unknown animation is an error
+// located at the include.
+TEST(SceneFile, IncludeAnimationAndTimeOffset) {
+    const std::string tri = gltf_dir() + "/AnimatedTriangle/glTF/AnimatedTriangle.gltf";
+    ImportOptions at;
+    at.time = 0.5;
+    const std::string json = doc(R"("camera": {"position": [0, 0, 9]},
+      "include": [{"file": ")" + tri + R"(", "time_offset": 0.25, "animation": "0"},
+                  {"file": ")" + tri + R"(", "time_offset": -2}])");
+    const Scene s = load_json(json, at);
+    ImportOptions later, first;
+    later.time = 0.75;
+    const Scene g = import_gltf(tri, later);
+    const Scene g0 = import_gltf(tri, first);
+    ASSERT_EQ(s.instances.size(), 2 * g.instances.size());
+    expect_mat(s.instances[0].world_from_object, g.instances[0].world_from_object);
+    expect_mat(s.instances[1].world_from_object, g0.instances[0].world_from_object);  // before the first key
+    EXPECT_NE(g.instances[0].world_from_object, g0.instances[0].world_from_object);
+    ASSERT_EQ(s.animations.size(), 2u);
+    EXPECT_EQ(s.time, 0.5);
+    const Error e = error_of(doc(R"("include": [{"file": ")" + tri + R"(", "animation": "walk"}])"));
+    EXPECT_NE(std::string(e.what()).find("no animation 'walk'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("included from"), std::string::npos) << e.what();
+}
+
 TEST(SceneFile, IncludeTransformsLightsAndCameras) {
     const std::string lamp = gltf_dir() + "/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf";
     const std::string cams = gltf_dir() + "/Cameras/glTF/Cameras.gltf";

@@ -1,0 +1,462 @@
+#include "importers/gltf_animation.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "importers/gltf_accessor.h"
+#include "importers/located_error.h"
+#include "importers/scene_loader.h"
+#include "scene/animation.h"
+
+namespace whitted {
+
+using namespace gltf;
+
+namespace {
+
+constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
+
+std::string animation_name(const tinygltf::Model& model, int a) {
+    const std::string& n = model.animations[size_t(a)].name;
+    return n.empty() ? fmt::format("animation {}", a) : n;
+}
+
+/// Morph targets of a mesh: the largest count over its primitives (the spec wants them equal).
+size_t target_count(const tinygltf::Mesh& mesh) {
+    size_t n = 0;
+    for (const tinygltf::Primitive& p : mesh.primitives) n = std::max(n, p.targets.size());
+    return n;
+}
+
+/// A node's translation, rotation and scale (or its fixed matrix), which channels overwrite. Only
+/// the parts present (in the file or from a channel) are multiplied in, so a node nothing animates
+/// gets the matrix node_local_transform() gives, bit for bit.
+struct NodeTrs {
+    std::array<double, 3> t{0, 0, 0};
+    std::array<double, 4> r{0, 0, 0, 1};
+    std::array<double, 3> s{1, 1, 1};
+    bool has_t = false, has_r = false, has_s = false;
+    bool has_matrix = false;
+    Mat4d matrix;
+
+    Mat4d local() const {
+        if (has_matrix) return matrix;
+        Mat4d m;
+        if (has_t) m = Mat4d::translate({t[0], t[1], t[2]});
+        if (has_r) {
+            const double n = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]);
+            if (n > 1e-12) m = m * Mat4d::rotate(r[0] / n, r[1] / n, r[2] / n, r[3] / n);
+        }
+        if (has_s) m = m * Mat4d::scale({s[0], s[1], s[2]});
+        return m;
+    }
+};
+
+NodeTrs node_trs(const tinygltf::Node& node) {
+    NodeTrs n;
+    if (node.matrix.size() == 16) {
+        n.has_matrix = true;
+        for (int c = 0; c < 4; ++c)  // glTF stores column-major
+            for (int r = 0; r < 4; ++r) n.matrix(r, c) = node.matrix[size_t(c * 4 + r)];
+    }
+    n.has_t = node.translation.size() == 3;
+    n.has_r = node.rotation.size() == 4;
+    n.has_s = node.scale.size() == 3;
+    for (size_t i = 0; i < 3 && n.has_t; ++i) n.t[i] = node.translation[i];
+    for (size_t i = 0; i < 4 && n.has_r; ++i) n.r[i] = node.rotation[i];
+    for (size_t i = 0; i < 3 && n.has_s; ++i) n.s[i] = node.scale[i];
+    return n;
+}
+
+/// Reads sampler `s` of animation `a` for `path`, checking its accessors against the spec.
+class SamplerReader {
+public:
+    SamplerReader(const tinygltf::Model& model, const std::string& file) : m_model(model), m_file(file) {}
+
+    AnimationSampler read(int a, int s, AnimationPath path, int components) const {
+        const std::string ptr = fmt::format("/animations/{}/samplers/{}", a, s);
+        const tinygltf::AnimationSampler& g = m_model.animations[size_t(a)].samplers[size_t(s)];
+        AnimationSampler out;
+        out.components = components;
+        if (g.interpolation == "STEP") out.interpolation = Interpolation::Step;
+        else if (g.interpolation == "CUBICSPLINE") out.interpolation = Interpolation::CubicSpline;
+        else if (g.interpolation.empty() || g.interpolation == "LINEAR") out.interpolation = Interpolation::Linear;
+        else fail(ptr + "/interpolation", "unknown interpolation '{}' (LINEAR, STEP or CUBICSPLINE)", g.interpolation);
+        const tinygltf::Accessor& in = accessor(g.input, ptr + "/input");
+        if (in.type != TINYGLTF_TYPE_SCALAR || in.componentType != kFloat)
+            fail(ptr + "/input", "key times must be a SCALAR FLOAT accessor (accessor {})", g.input);
+        out.times.resize(in.count);
+        for_each_element(accessor_data(m_model, g.input), [&](size_t i, const float* v) { out.times[i] = v[0]; });
+        const tinygltf::Accessor& o = accessor(g.output, ptr + "/output");
+        const bool normalized_int = o.normalized && o.componentType != kFloat;
+        const int expected_type = path == AnimationPath::Weights ? TINYGLTF_TYPE_SCALAR
+                                  : path == AnimationPath::Rotation ? TINYGLTF_TYPE_VEC4
+                                                                    : TINYGLTF_TYPE_VEC3;
+        const bool int_ok = path == AnimationPath::Rotation || path == AnimationPath::Weights;
+        if (o.type != expected_type || !(o.componentType == kFloat || (int_ok && normalized_int)))
+            fail(ptr + "/output", "{} values must be a {} FLOAT{} accessor (accessor {} is {} {})", path_name(path),
+                 type_name(expected_type), int_ok ? " or normalized integer" : "", g.output, type_name(o.type),
+                 component_type_name(o.componentType));
+        const size_t per = size_t(component_count(o.type));
+        out.values.assign(o.count * per, 0.f);
+        for_each_element(accessor_data(m_model, g.output), [&](size_t i, const float* v) {
+            for (size_t c = 0; c < per; ++c) out.values[i * per + c] = v[c];
+        });
+        try {
+            validate_animation_sampler(out, "");
+        } catch (const Error& e) {
+            std::string what = e.what();
+            if (what.rfind(": ", 0) == 0) what = what.substr(2);
+            fail(ptr, "{} ({} keys, output accessor {})", what, out.times.size(), g.output);
+        }
+        return out;
+    }
+
+    static const char* path_name(AnimationPath p) {
+        switch (p) {
+            case AnimationPath::Translation: return "translation";
+            case AnimationPath::Rotation: return "rotation";
+            case AnimationPath::Scale: return "scale";
+            default: return "weights";
+        }
+    }
+
+    template <typename... Args>
+    [[noreturn]] void fail(const std::string& pointer, fmt::format_string<Args...> f, Args&&... args) const {
+        throw Error(file_loc(m_file, pointer), fmt::format(f, std::forward<Args>(args)...));
+    }
+
+private:
+    const tinygltf::Accessor& accessor(int index, const std::string& ptr) const {
+        if (index < 0 || size_t(index) >= m_model.accessors.size())
+            fail(ptr, "accessor {} does not exist (the file has {})", index, m_model.accessors.size());
+        return m_model.accessors[size_t(index)];
+    }
+
+    const tinygltf::Model& m_model;
+    const std::string& m_file;
+};
+
+/// The default morph weights of node `n`: node.weights, else mesh.weights, else 0 (empty: no targets).
+std::vector<float> default_weights(const tinygltf::Model& model, const std::string& file, int n) {
+    const tinygltf::Node& node = model.nodes[size_t(n)];
+    if (node.mesh < 0) return {};
+    const tinygltf::Mesh& mesh = model.meshes[size_t(node.mesh)];
+    const size_t targets = target_count(mesh);
+    if (targets == 0) return {};
+    for (const tinygltf::Primitive& p : mesh.primitives)
+        if (p.targets.size() != targets)
+            throw Error(file_loc(file, fmt::format("/meshes/{}", node.mesh)),
+                        fmt::format("its primitives have different numbers of morph targets ({} and {})",
+                                    p.targets.size(), targets));
+    auto take = [&](const std::vector<double>& w, const std::string& ptr) {
+        if (w.size() != targets)
+            throw Error(file_loc(file, ptr), fmt::format("{} weights for {} morph targets", w.size(), targets));
+        std::vector<float> out(targets);
+        for (size_t i = 0; i < targets; ++i) {
+            if (!std::isfinite(w[i])) throw Error(file_loc(file, ptr), fmt::format("weight {} is not finite", i));
+            out[i] = float(w[i]);
+        }
+        return out;
+    };
+    if (!node.weights.empty()) return take(node.weights, fmt::format("/nodes/{}/weights", n));
+    if (!mesh.weights.empty()) return take(mesh.weights, fmt::format("/meshes/{}/weights", node.mesh));
+    return std::vector<float>(targets, 0.f);
+}
+
+}  // namespace
+
+std::vector<int> choose_animations(const tinygltf::Model& model, const std::string& path, const std::string& choice) {
+    const int n = int(model.animations.size());
+    std::vector<int> out;
+    if (choice.empty() || choice == "all") {
+        for (int a = 0; a < n; ++a) out.push_back(a);
+        return out;
+    }
+    auto available = [&] {
+        if (n == 0) return std::string("the file has no animation");
+        std::string s = "the file has:";
+        for (int a = 0; a < n; ++a) s += fmt::format(" {} \"{}\"{}", a, animation_name(model, a), a + 1 < n ? "," : "");
+        return s;
+    };
+    for (int a = 0; a < n; ++a)
+        if (model.animations[size_t(a)].name == choice) return {a};
+    std::stringstream in(choice);
+    for (std::string item; std::getline(in, item, ',');) {
+        size_t used = 0;
+        int index = -1;
+        try {
+            index = std::stoi(item, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used != item.size() || item.empty() || index < 0 || index >= n)
+            throw Error(file_loc(path), fmt::format("--animation {}: no animation '{}' ({})", choice, item, available()));
+        if (std::find(out.begin(), out.end(), index) == out.end()) out.push_back(index);
+    }
+    return out;
+}
+
+GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const std::vector<int>& animations,
+                    double time, bool loop, WarningLog& warnings) {
+    check_animation_time(time, "--time");
+    const size_t count = model.nodes.size();
+    std::vector<NodeTrs> trs(count);
+    GltfPose pose;
+    pose.weights.resize(count);
+    for (size_t n = 0; n < count; ++n) {
+        trs[n] = node_trs(model.nodes[n]);
+        pose.weights[n] = default_weights(model, path, int(n));
+    }
+    const SamplerReader reader(model, path);
+    for (const int a : animations) {
+        const tinygltf::Animation& anim = model.animations[size_t(a)];
+        // Every sampler's last key: the animation's duration (for --loop).
+        double duration = 0.0;
+        for (const tinygltf::AnimationSampler& s : anim.samplers)
+            if (s.input >= 0 && size_t(s.input) < model.accessors.size() && !model.accessors[size_t(s.input)].maxValues.empty())
+                duration = std::max(duration, model.accessors[size_t(s.input)].maxValues[0]);
+        const double t = loop && duration > 0.0 ? std::fmod(time, duration) : time;
+        for (size_t c = 0; c < anim.channels.size(); ++c) {
+            const tinygltf::AnimationChannel& ch = anim.channels[c];
+            const std::string ptr = fmt::format("/animations/{}/channels/{}", a, c);
+            if (ch.target_path == "pointer" || (ch.target_node < 0 && !ch.target_extensions.empty())) {
+                warnings.add("animation-pointer", fmt::format("{}: KHR_animation_pointer channels are not applied "
+                                                              "yet (first: {})", animation_name(model, a), ptr));
+                continue;
+            }
+            if (ch.target_node < 0 || size_t(ch.target_node) >= count)
+                reader.fail(ptr + "/target/node", "node {} does not exist (the file has {})", ch.target_node, count);
+            if (ch.sampler < 0 || size_t(ch.sampler) >= anim.samplers.size())
+                reader.fail(ptr + "/sampler", "sampler {} does not exist (the animation has {})", ch.sampler,
+                            anim.samplers.size());
+            const int node = ch.target_node;
+            AnimationPath p;
+            int components = 3;
+            if (ch.target_path == "translation") p = AnimationPath::Translation;
+            else if (ch.target_path == "rotation") p = AnimationPath::Rotation, components = 4;
+            else if (ch.target_path == "scale") p = AnimationPath::Scale;
+            else if (ch.target_path == "weights") {
+                p = AnimationPath::Weights;
+                components = int(pose.weights[size_t(node)].size());
+                if (components == 0)
+                    reader.fail(ptr + "/target", "animates the morph weights of node {}, whose mesh has no morph "
+                                "targets", node);
+            } else {
+                reader.fail(ptr + "/target/path", "unknown path '{}' (translation, rotation, scale or weights)",
+                            ch.target_path);
+            }
+            if (p != AnimationPath::Weights && trs[size_t(node)].has_matrix)
+                reader.fail(ptr + "/target", "animates node {}, which has a matrix (an animated node must use "
+                            "translation, rotation and scale)", node);
+            const AnimationSampler s = reader.read(a, ch.sampler, p, components);
+            std::vector<float> v(static_cast<size_t>(components));
+            sample_animation(s, p, float(t), v.data());
+            NodeTrs& n = trs[size_t(node)];
+            if (p == AnimationPath::Translation) {
+                n.t = {v[0], v[1], v[2]};
+                n.has_t = true;
+            } else if (p == AnimationPath::Rotation) {
+                n.r = {v[0], v[1], v[2], v[3]};
+                n.has_r = true;
+            } else if (p == AnimationPath::Scale) {
+                n.s = {v[0], v[1], v[2]};
+                n.has_s = true;
+            } else {
+                pose.weights[size_t(node)] = v;
+            }
+        }
+    }
+    // Global transforms over the whole node forest: joints outside the rendered scene are posed too.
+    pose.local.resize(count);
+    for (size_t n = 0; n < count; ++n) pose.local[n] = trs[n].local();
+    std::vector<int> parent(count, -1);
+    for (size_t n = 0; n < count; ++n)
+        for (const int c : model.nodes[n].children)
+            if (c >= 0 && size_t(c) < count) parent[size_t(c)] = int(n);
+    pose.world.resize(count);
+    std::vector<uint8_t> done(count, 0);
+    for (size_t n = 0; n < count; ++n) {
+        // Walk up to the first node whose world is known (the validated graph has no cycle), then down.
+        std::vector<int> chain;
+        for (int k = int(n); k >= 0 && !done[size_t(k)]; k = parent[size_t(k)]) chain.push_back(k);
+        for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+            const int k = *it, up = parent[size_t(k)];
+            pose.world[size_t(k)] = up >= 0 ? pose.world[size_t(up)] * pose.local[size_t(k)] : pose.local[size_t(k)];
+            done[size_t(k)] = 1;
+        }
+    }
+    return pose;
+}
+
+bool deformed(const tinygltf::Model& model, int node, int primitive) {
+    const tinygltf::Node& n = model.nodes[size_t(node)];
+    if (n.mesh < 0) return false;
+    const tinygltf::Primitive& p = model.meshes[size_t(n.mesh)].primitives[size_t(primitive)];
+    return !p.targets.empty() || (n.skin >= 0 && p.attributes.count("JOINTS_0") && p.attributes.count("WEIGHTS_0"));
+}
+
+namespace {
+
+/// Adds weights[t] times target t's `attribute` displacements into `out` (nothing without targets).
+void add_targets(const tinygltf::Model& model, const tinygltf::Primitive& p, const std::vector<float>& weights,
+                 const char* attribute, std::vector<Vec3d>& out) {
+    for (size_t t = 0; t < p.targets.size() && t < weights.size(); ++t) {
+        const auto it = p.targets[t].find(attribute);
+        if (it == p.targets[t].end() || weights[t] == 0.f) continue;
+        const double w = weights[t];
+        for_each_element(accessor_data(model, it->second), [&](size_t i, const float* v) {
+            if (i < out.size()) out[i] += Vec3d(v[0], v[1], v[2]) * w;
+        });
+    }
+}
+
+/// Per vertex, the skin matrix: the sum of its joints' matrices times their weights (every
+/// JOINTS_n/WEIGHTS_n set; weights divided by their sum when it is neither 0 nor 1).
+std::vector<Mat4d> skin_matrices(const tinygltf::Model& model, const std::string& path, int node,
+                                 const tinygltf::Primitive& p, size_t vertices, const GltfPose& pose) {
+    const int skin_index = model.nodes[size_t(node)].skin;
+    const tinygltf::Skin& skin = model.skins[size_t(skin_index)];
+    const std::string sptr = fmt::format("/skins/{}", skin_index);
+    std::vector<Mat4d> joint(skin.joints.size());
+    std::vector<Mat4d> inverse_bind(skin.joints.size());
+    if (skin.inverseBindMatrices >= 0) {
+        if (size_t(skin.inverseBindMatrices) >= model.accessors.size())
+            throw Error(file_loc(path, sptr + "/inverseBindMatrices"),
+                        fmt::format("accessor {} does not exist", skin.inverseBindMatrices));
+        const tinygltf::Accessor& a = model.accessors[size_t(skin.inverseBindMatrices)];
+        if (a.type != TINYGLTF_TYPE_MAT4 || a.componentType != kFloat || a.count < skin.joints.size())
+            throw Error(file_loc(path, sptr + "/inverseBindMatrices"),
+                        fmt::format("must be a MAT4 FLOAT accessor of at least {} matrices (accessor {})",
+                                    skin.joints.size(), skin.inverseBindMatrices));
+        for_each_element(accessor_data(model, skin.inverseBindMatrices), [&](size_t i, const float* v) {
+            if (i >= inverse_bind.size()) return;
+            for (int c = 0; c < 4; ++c)
+                for (int r = 0; r < 4; ++r) inverse_bind[i](r, c) = v[c * 4 + r];
+        });
+    }
+    for (size_t j = 0; j < skin.joints.size(); ++j) {
+        const int jn = skin.joints[j];
+        if (jn < 0 || size_t(jn) >= model.nodes.size())
+            throw Error(file_loc(path, fmt::format("{}/joints/{}", sptr, j)), fmt::format("node {} does not exist", jn));
+        joint[j] = pose.world[size_t(jn)] * inverse_bind[j];
+    }
+    // Every set's joints and weights, 4 per set.
+    std::vector<std::array<float, 4>> joints_of, weights_of;
+    std::vector<double> sum(vertices, 0.0);
+    std::vector<Mat4d> out(vertices);
+    for (Mat4d& m : out) m.m.fill(0.0);
+    for (int set = 0;; ++set) {
+        const auto ji = p.attributes.find(fmt::format("JOINTS_{}", set));
+        const auto wi = p.attributes.find(fmt::format("WEIGHTS_{}", set));
+        if (ji == p.attributes.end() || wi == p.attributes.end()) break;
+        joints_of.assign(vertices, {0, 0, 0, 0});
+        weights_of.assign(vertices, {0, 0, 0, 0});
+        for_each_element(accessor_data(model, ji->second), [&](size_t i, const float* v) {
+            if (i < vertices) joints_of[i] = {v[0], v[1], v[2], v[3]};
+        });
+        for_each_element(accessor_data(model, wi->second), [&](size_t i, const float* v) {
+            if (i < vertices) weights_of[i] = {v[0], v[1], v[2], v[3]};
+        });
+        for (size_t i = 0; i < vertices; ++i)
+            for (int k = 0; k < 4; ++k) {
+                const double w = weights_of[i][size_t(k)];
+                if (w == 0.0) continue;
+                const float jf = joints_of[i][size_t(k)];
+                if (!(jf >= 0.f && size_t(jf) < joint.size()))
+                    throw Error(file_loc(path, fmt::format("/accessors/{}", ji->second)),
+                                fmt::format("JOINTS_{} of vertex {} is {}, outside skin {}'s {} joints", set, i, jf,
+                                            skin_index, joint.size()));
+                const Mat4d& J = joint[size_t(jf)];
+                for (size_t e = 0; e < 16; ++e) out[i].m[e] += w * J.m[e];
+                sum[i] += w;
+            }
+    }
+    for (size_t i = 0; i < vertices; ++i)
+        if (sum[i] != 0.0 && sum[i] != 1.0)
+            for (double& e : out[i].m) e /= sum[i];
+    return out;
+}
+
+}  // namespace
+
+void deform_mesh(Mesh& mesh, const tinygltf::Model& model, const std::string& path, int node, int primitive,
+                 const GltfPose& pose) {
+    const tinygltf::Node& n = model.nodes[size_t(node)];
+    const tinygltf::Primitive& p = model.meshes[size_t(n.mesh)].primitives[size_t(primitive)];
+    const size_t nv = mesh.positions.size();
+    std::vector<Vec3d> pos(nv), nrm(nv), tan(nv);
+    for (size_t i = 0; i < nv; ++i) pos[i] = Vec3d(mesh.positions[i]);
+    for (size_t i = 0; i < mesh.normals.size() && i < nv; ++i) nrm[i] = Vec3d(mesh.normals[i]);
+    for (size_t i = 0; i < mesh.tangents.size() && i < nv; ++i) tan[i] = Vec3d(mesh.tangents[i].xyz());
+    // Morph targets (glTF 2.0 section 3.7.2.2): base + sum of weight x displacement.
+    const std::vector<float>& w = pose.weights[size_t(node)];
+    add_targets(model, p, w, "POSITION", pos);
+    if (!mesh.normals.empty()) add_targets(model, p, w, "NORMAL", nrm);
+    if (!mesh.tangents.empty()) add_targets(model, p, w, "TANGENT", tan);
+    // The skin (section 3.7.3): world-space vertices; the mesh node's own transform does not apply.
+    if (n.skin >= 0 && p.attributes.count("JOINTS_0") && p.attributes.count("WEIGHTS_0")) {
+        const std::vector<Mat4d> m = skin_matrices(model, path, node, p, nv, pose);
+        for (size_t i = 0; i < nv; ++i) {
+            pos[i] = m[i].apply_point(pos[i]);
+            const Mat4d normal_matrix = m[i].inverse_affine().transposed();
+            nrm[i] = normal_matrix.apply_vector(nrm[i]);
+            tan[i] = m[i].apply_vector(tan[i]);
+        }
+    }
+    for (size_t i = 0; i < nv; ++i) mesh.positions[i] = Vec3f(pos[i]);
+    auto unit = [](const Vec3d& v, const Vec3f& fallback) {
+        const double l = length(v);
+        return l > 1e-30 && std::isfinite(l) ? Vec3f(v / l) : fallback;
+    };
+    for (size_t i = 0; i < mesh.normals.size() && i < nv; ++i) mesh.normals[i] = unit(nrm[i], mesh.normals[i]);
+    for (size_t i = 0; i < mesh.tangents.size() && i < nv; ++i)
+        mesh.tangents[i] = Vec4f(unit(tan[i], mesh.tangents[i].xyz()), mesh.tangents[i].w);
+}
+
+void describe_animation(const tinygltf::Model& model, const std::vector<int>& posed, Scene& scene) {
+    for (size_t a = 0; a < model.animations.size(); ++a) {
+        const tinygltf::Animation& anim = model.animations[a];
+        AnimationInfo info;
+        info.name = animation_name(model, int(a));
+        info.channels = anim.channels.size();
+        std::set<std::string> kinds;
+        for (const tinygltf::AnimationSampler& s : anim.samplers) {
+            kinds.insert(s.interpolation.empty() ? "LINEAR" : s.interpolation);
+            if (s.input >= 0 && size_t(s.input) < model.accessors.size() && !model.accessors[size_t(s.input)].maxValues.empty())
+                info.duration = std::max(info.duration, float(model.accessors[size_t(s.input)].maxValues[0]));
+        }
+        for (const std::string& k : kinds) {
+            if (!info.interpolations.empty()) info.interpolations += ',';
+            info.interpolations += k;
+        }
+        info.posed = std::find(posed.begin(), posed.end(), int(a)) != posed.end();
+        scene.animations.push_back(std::move(info));
+    }
+    for (size_t s = 0; s < model.skins.size(); ++s) {
+        SkinInfo info;
+        info.name = model.skins[s].name.empty() ? fmt::format("skin {}", s) : model.skins[s].name;
+        info.joints = model.skins[s].joints.size();
+        for (const Instance& inst : scene.instances)
+            if (inst.node >= 0 && model.nodes[size_t(inst.node)].skin == int(s)) ++info.meshes;
+        scene.skins.push_back(std::move(info));
+    }
+    for (size_t m = 0; m < model.meshes.size(); ++m) {
+        const size_t targets = target_count(model.meshes[m]);
+        if (targets == 0) continue;
+        MorphInfo info;
+        info.mesh = model.meshes[m].name.empty() ? fmt::format("mesh {}", m) : model.meshes[m].name;
+        info.targets = targets;
+        for (const double w : model.meshes[m].weights) info.default_weights.push_back(float(w));
+        scene.morphs.push_back(std::move(info));
+    }
+}
+
+}  // namespace whitted

@@ -1,0 +1,52 @@
+// A glTF file posed at one moment: animations (glTF 2.0 section 3.11) set the nodes' translation,
+// rotation, scale and morph weights; skins (section 3.7.3) and morph targets (section 3.7.2.2)
+// deform the meshes. The importer places instances, cameras and lights with the posed transforms
+// and builds each deformed mesh from its node's pose (docs/gltf-support.md "Animation").
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <tiny_gltf.h>
+
+#include "core/vecmath.h"
+#include "importers/warning_log.h"
+#include "scene/scene.h"
+
+namespace whitted {
+
+/// Every node of a file at one time: what the traversal and the mesh deformation read.
+struct GltfPose {
+    std::vector<Mat4d> local;                 ///< per node: its local transform
+    std::vector<Mat4d> world;                 ///< per node: its global transform (every root of the file)
+    std::vector<std::vector<float>> weights;  ///< per node: morph weights of its mesh (empty: no targets)
+};
+
+/// The animations `choice` names: "all" (every one), a name, or indices "0,2". Throws
+/// whitted::Error naming the file and listing the animations it has when one does not exist.
+std::vector<int> choose_animations(const tinygltf::Model& model, const std::string& path, const std::string& choice);
+
+/// The nodes at `time` seconds under `animations` (each looping over its duration when `loop`),
+/// with morph weights from the animation, else node.weights, else mesh.weights, else 0. Validates
+/// what it reads and throws whitted::Error naming the file, the animation or node and the problem
+/// (key times, value counts, targets, weights counts). KHR_animation_pointer channels are skipped
+/// with a warning.
+GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const std::vector<int>& animations,
+                    double time, bool loop, WarningLog& warnings);
+
+/// True when node `node`'s primitive needs a mesh of its own: it has a skin, or morph targets.
+bool deformed(const tinygltf::Model& model, int node, int primitive);
+
+/// Deforms `mesh`, built from `primitive` of node `node`'s mesh, to the pose: morph targets first
+/// (POSITION, NORMAL, TANGENT displacements times the node's weights), then the skin (each vertex by
+/// its weighted joint matrices global(joint) x inverseBindMatrix, normals by their inverse
+/// transpose, tangents by the 3x3), in world space for a skinned mesh. Throws whitted::Error for
+/// joint indices outside the skin.
+void deform_mesh(Mesh& mesh, const tinygltf::Model& model, const std::string& path, int node, int primitive,
+                 const GltfPose& pose);
+
+/// The file's animations, skins and morphed meshes as Scene records (`posed`: the chosen ones).
+void describe_animation(const tinygltf::Model& model, const std::vector<int>& posed, Scene& scene);
+
+}  // namespace whitted
