@@ -171,6 +171,30 @@ std::vector<float> default_weights(const tinygltf::Model& model, const std::stri
     return std::vector<float>(targets, 0.f);
 }
 
+/// A KHR_animation_pointer channel's JSON pointer ("" when it has none).
+std::string animation_pointer(const tinygltf::AnimationChannel& ch) {
+    const auto ext = ch.target_extensions.find("KHR_animation_pointer");
+    if (ext == ch.target_extensions.end() || !ext->second.IsObject() || !ext->second.Has("pointer")) return {};
+    const tinygltf::Value& v = ext->second.Get("pointer");
+    return v.IsString() ? v.Get<std::string>() : std::string();
+}
+
+/// "/nodes/N/translation" (rotation, scale, weights) as a node and a core path; false for others.
+bool node_pointer(const std::string& pointer, int& node, std::string& path) {
+    const std::string prefix = "/nodes/";
+    if (pointer.rfind(prefix, 0) != 0) return false;
+    const size_t slash = pointer.find('/', prefix.size());
+    if (slash == std::string::npos || slash == prefix.size()) return false;
+    const std::string index = pointer.substr(prefix.size(), slash - prefix.size());
+    if (index.size() > 9 || index.find_first_not_of("0123456789") != std::string::npos) return false;
+    const std::string property = pointer.substr(slash + 1);
+    if (property != "translation" && property != "rotation" && property != "scale" && property != "weights")
+        return false;
+    node = std::stoi(index);
+    path = property;
+    return true;
+}
+
 }  // namespace
 
 std::vector<int> choose_animations(const tinygltf::Model& model, const std::string& path, const std::string& choice) {
@@ -227,23 +251,30 @@ GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const
         for (size_t c = 0; c < anim.channels.size(); ++c) {
             const tinygltf::AnimationChannel& ch = anim.channels[c];
             const std::string ptr = fmt::format("/animations/{}/channels/{}", a, c);
-            if (ch.target_path == "pointer" || (ch.target_node < 0 && !ch.target_extensions.empty())) {
-                warnings.add("animation-pointer", fmt::format("{}: KHR_animation_pointer channels are not applied "
-                                                              "yet (first: {})", animation_name(model, a), ptr));
-                continue;
+            int node = ch.target_node;
+            std::string path_name = ch.target_path;
+            if (ch.target_path == "pointer") {
+                // KHR_animation_pointer: the node properties a core channel could target.
+                const std::string pointer = animation_pointer(ch);
+                if (!node_pointer(pointer, node, path_name)) {
+                    warnings.add("animation-pointer:" + pointer,
+                                 fmt::format("{}: KHR_animation_pointer target {} is not applied (whitted animates "
+                                             "/nodes/N/translation, rotation, scale and weights)",
+                                             animation_name(model, a), pointer.empty() ? "(none)" : pointer));
+                    continue;
+                }
             }
-            if (ch.target_node < 0 || size_t(ch.target_node) >= count)
-                reader.fail(ptr + "/target/node", "node {} does not exist (the file has {})", ch.target_node, count);
+            if (node < 0 || size_t(node) >= count)
+                reader.fail(ptr + "/target", "node {} does not exist (the file has {})", node, count);
             if (ch.sampler < 0 || size_t(ch.sampler) >= anim.samplers.size())
                 reader.fail(ptr + "/sampler", "sampler {} does not exist (the animation has {})", ch.sampler,
                             anim.samplers.size());
-            const int node = ch.target_node;
             AnimationPath p;
             int components = 3;
-            if (ch.target_path == "translation") p = AnimationPath::Translation;
-            else if (ch.target_path == "rotation") p = AnimationPath::Rotation, components = 4;
-            else if (ch.target_path == "scale") p = AnimationPath::Scale;
-            else if (ch.target_path == "weights") {
+            if (path_name == "translation") p = AnimationPath::Translation;
+            else if (path_name == "rotation") p = AnimationPath::Rotation, components = 4;
+            else if (path_name == "scale") p = AnimationPath::Scale;
+            else if (path_name == "weights") {
                 p = AnimationPath::Weights;
                 components = int(pose.weights[size_t(node)].size());
                 if (components == 0)
@@ -251,7 +282,7 @@ GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const
                                 "targets", node);
             } else {
                 reader.fail(ptr + "/target/path", "unknown path '{}' (translation, rotation, scale or weights)",
-                            ch.target_path);
+                            path_name);
             }
             if (p != AnimationPath::Weights && trs[size_t(node)].has_matrix)
                 reader.fail(ptr + "/target", "animates node {}, which has a matrix (an animated node must use "

@@ -13,17 +13,41 @@
 
 namespace whitted {
 
-std::optional<std::vector<uint8_t>> prepare_compressed(std::span<const uint8_t> file, bool binary, size_t json_offset,
-                                                       size_t json_size) {
+namespace {
+
+/// KHR_animation_pointer targets have no `node`, which tinygltf 2.7 requires: -1 stands for none.
+bool add_pointer_channel_nodes(nlohmann::json& doc) {
+    bool changed = false;
+    const auto animations = doc.find("animations");
+    if (animations == doc.end() || !animations->is_array()) return false;
+    for (nlohmann::json& a : *animations) {
+        if (!a.is_object() || !a.contains("channels") || !a["channels"].is_array()) continue;
+        for (nlohmann::json& c : a["channels"]) {
+            if (!c.is_object() || !c.contains("target") || !c["target"].is_object()) continue;
+            nlohmann::json& t = c["target"];
+            if (t.contains("node")) continue;
+            t["node"] = -1;
+            changed = true;
+        }
+    }
+    return changed;
+}
+
+}  // namespace
+
+std::optional<std::vector<uint8_t>> prepare_for_tinygltf(std::span<const uint8_t> file, bool binary,
+                                                         size_t json_offset, size_t json_size) {
     const char* json = reinterpret_cast<const char*>(file.data()) + json_offset;
     const std::string_view text_in(json, json_size);
     const bool meshopt = text_in.find("EXT_meshopt_compression") != std::string_view::npos;
     const bool draco = text_in.find("KHR_draco_mesh_compression") != std::string_view::npos;
-    if (!meshopt && !draco) return std::nullopt;
+    const bool pointer = text_in.find("KHR_animation_pointer") != std::string_view::npos;
+    if (!meshopt && !draco && !pointer) return std::nullopt;
     nlohmann::json doc = nlohmann::json::parse(json, json + json_size, nullptr, false);
-    if (doc.is_discarded()) return std::nullopt;  // tinygltf reports the JSON error
+    if (doc.is_discarded() || !doc.is_object()) return std::nullopt;  // tinygltf reports the JSON error
     bool changed = meshopt && add_meshopt_fallback_uris(doc, binary);
     changed = (draco && detach_draco_indices(doc)) || changed;
+    changed = (pointer && add_pointer_channel_nodes(doc)) || changed;
     if (!changed) return std::nullopt;
 
     std::string text = doc.dump();

@@ -449,7 +449,8 @@ private:
         // Compressed geometry: EXT_meshopt_compression's fallback buffers carry no data (they get a
         // uri the file callbacks serve as zeros), a Draco primitive's indices accessor has no
         // bufferView (it moves out of tinygltf's sight); both are decoded after parsing.
-        const std::optional<std::vector<uint8_t>> rewritten = prepare_compressed(bytes, binary, json_offset, json_size);
+        // KHR_animation_pointer targets get the node tinygltf insists on (-1).
+        const std::optional<std::vector<uint8_t>> rewritten = prepare_for_tinygltf(bytes, binary, json_offset, json_size);
         const std::span<const uint8_t> file = rewritten ? std::span<const uint8_t>(*rewritten) : bytes;
 
         m_loader.keep_bytes = m_options.load_textures;

@@ -184,6 +184,33 @@ TEST(GltfAnimation, LinearTranslationInterpolatesAndReplacesTheNodeTranslation) 
     EXPECT_VEC3_NEAR(translation_at(glb, 1.25), 2.0, 0.0, 0.0, 1e-6);
 }
 
+// KHR_animation_pointer: a pointer to a node's translation animates it like a core channel (in a
+// GLB, whose JSON chunk is rewritten before tinygltf parses it); a pointer whitted does not apply
+// (a material factor) is one warning naming it, and the rest of the animation still applies.
+TEST(GltfAnimation, AnimationPointerToANodeAnimatesIt) {
+    Glb b;
+    const int pos = b.floats(kTriangle, "VEC3", true);
+    const int in = b.floats({0, 1}, "SCALAR", true);
+    const int out = b.floats({0, 0, 0, 2, 0, 0}, "VEC3");
+    const int color = b.floats({1, 1, 1, 1, 0, 0, 0, 1}, "VEC4");
+    const auto glb = b.glb(fill(R"("scene":0,"scenes":[{"nodes":[0]}],"extensionsUsed":["KHR_animation_pointer"],
+        "nodes":[{"name":"tri","mesh":0}],"materials":[{}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":@pos@},"material":0}]}],
+        "animations":[{"samplers":[{"input":@in@,"output":@out@},{"input":@in@,"output":@color@}],
+          "channels":[{"sampler":0,"target":{"path":"pointer",
+                         "extensions":{"KHR_animation_pointer":{"pointer":"/nodes/0/translation"}}}},
+                      {"sampler":1,"target":{"path":"pointer",
+                         "extensions":{"KHR_animation_pointer":{"pointer":"/materials/0/pbrMetallicRoughness/baseColorFactor"}}}}]}])",
+                                {{"pos", pos}, {"in", in}, {"out", out}, {"color", color}}));
+    EXPECT_VEC3_NEAR(translation_at(glb, 0.25), 0.5, 0.0, 0.0, 1e-6);
+    const Scene s = import(glb, at_time(0.75));
+    EXPECT_VEC3_NEAR(origin_of(instance_of(s, "tri").world_from_object), 1.5, 0.0, 0.0, 1e-6);
+    size_t warned = 0;
+    for (const std::string& w : s.warnings)
+        warned += w.find("/materials/0/pbrMetallicRoughness/baseColorFactor is not applied") != std::string::npos;
+    EXPECT_EQ(warned, 1u);
+}
+
 // Keys at 1 s and 2 s: before the first key the first value holds.
 TEST(GltfAnimation, BeforeTheFirstKeyTheFirstValueHolds) {
     const auto glb = animated_translation({1, 2}, {3, 0, 0, 5, 0, 0}, "LINEAR");
