@@ -37,6 +37,7 @@
 
 #include "benchmarks/bench_commands.h"
 #include "benchmarks/bench_images.h"
+#include "benchmarks/irradiance_check.h"
 #include "benchmarks/bench_timing.h"
 #include "importers/environment_image.h"
 #include "importers/scene_loader.h"
@@ -345,24 +346,6 @@ double thread_seconds() {
     timespec t{};
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
     return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
-/// `count` unit directions, uniform on the sphere, from a fixed seed.
-std::vector<Vec3f> random_directions(int count, uint32_t seed) {
-    std::mt19937 rng(seed);
-    std::normal_distribution<float> g;
-    std::vector<Vec3f> out;
-    while (int(out.size()) < count) {
-        const Vec3f d{g(rng), g(rng), g(rng)};
-        if (length(d) > 1e-3f) out.push_back(normalize(d));
-    }
-    return out;
-}
-
-float max_relative_error(const Color& got, const Color& want) {
-    float e = 0.f;
-    for (int c = 0; c < 3; ++c) e = std::max(e, std::fabs(got[c] - want[c]) / std::max(std::fabs(want[c]), 1e-12f));
-    return e;
 }
 
 /// For every map: build and split costs (thread CPU time); then per threshold rule and light count

@@ -19,6 +19,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include "benchmarks/irradiance_check.h"
 #include "importers/environment_image.h"
 #include "core/error.h"
 #include "shading/environment_map.h"
@@ -69,23 +70,6 @@ float angle_between(const Vec3f& a, const Vec3f& b) {
 const std::vector<Vec3f>& axes() {
     static const std::vector<Vec3f> a{{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
     return a;
-}
-
-std::vector<Vec3f> random_directions(int count, uint32_t seed) {
-    std::mt19937 rng(seed);
-    std::normal_distribution<float> g;
-    std::vector<Vec3f> out;
-    while (int(out.size()) < count) {
-        const Vec3f d{g(rng), g(rng), g(rng)};
-        if (length(d) > 1e-3f) out.push_back(normalize(d));
-    }
-    return out;
-}
-
-float max_relative_error(const Color& got, const Color& want) {
-    float e = 0.f;
-    for (int c = 0; c < 3; ++c) e = std::max(e, std::fabs(got[c] - want[c]) / std::max(std::fabs(want[c]), 1e-12f));
-    return e;
 }
 
 Environment bundled(const std::string& name) {
