@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -80,7 +81,8 @@ class SamplerReader {
 public:
     SamplerReader(const tinygltf::Model& model, const std::string& file) : m_model(model), m_file(file) {}
 
-    AnimationSampler read(int a, int s, AnimationPath path, int components) const {
+    /// `label` names the animated property in messages (default: the path's name).
+    AnimationSampler read(int a, int s, AnimationPath path, int components, const char* label = nullptr) const {
         const std::string ptr = fmt::format("/animations/{}/samplers/{}", a, s);
         const tinygltf::AnimationSampler& g = m_model.animations[size_t(a)].samplers[size_t(s)];
         AnimationSampler out;
@@ -101,7 +103,8 @@ public:
                                                                     : TINYGLTF_TYPE_VEC3;
         const bool int_ok = path == AnimationPath::Rotation || path == AnimationPath::Weights;
         if (o.type != expected_type || !(o.componentType == kFloat || (int_ok && normalized_int)))
-            fail(ptr + "/output", "{} values must be a {} FLOAT{} accessor (accessor {} is {} {})", path_name(path),
+            fail(ptr + "/output", "{} values must be a {} FLOAT{} accessor (accessor {} is {} {})",
+                 label ? label : path_name(path),
                  type_name(expected_type), int_ok ? " or normalized integer" : "", g.output, type_name(o.type),
                  component_type_name(o.componentType));
         const size_t per = size_t(component_count(o.type));
@@ -177,6 +180,53 @@ std::string animation_pointer(const tinygltf::AnimationChannel& ch) {
     if (ext == ch.target_extensions.end() || !ext->second.IsObject() || !ext->second.Has("pointer")) return {};
     const tinygltf::Value& v = ext->second.Get("pointer");
     return v.IsString() ? v.Get<std::string>() : std::string();
+}
+
+/// "<prefix>N<suffix>" as N; false when `pointer` has another shape.
+bool indexed_pointer(const std::string& pointer, const std::string& prefix, const std::string& suffix, int& index) {
+    if (pointer.size() <= prefix.size() + suffix.size() || pointer.rfind(prefix, 0) != 0 ||
+        pointer.compare(pointer.size() - suffix.size(), suffix.size(), suffix) != 0)
+        return false;
+    const std::string n = pointer.substr(prefix.size(), pointer.size() - prefix.size() - suffix.size());
+    if (n.empty() || n.size() > 9 || n.find_first_not_of("0123456789") != std::string::npos) return false;
+    index = std::stoi(n);
+    return true;
+}
+
+/// Applies a KHR_animation_pointer channel to a camera's yfov or a light's color or intensity;
+/// false when the pointer is not one of those.
+bool apply_object_pointer(const tinygltf::Model& model, const SamplerReader& reader, const std::string& pointer,
+                          int a, const tinygltf::AnimationChannel& ch, const std::string& ptr, double t,
+                          GltfPose& pose) {
+    int index = -1;
+    std::vector<std::vector<float>>* target = nullptr;
+    size_t objects = 0;
+    int components = 1;
+    const char* label = "";
+    if (indexed_pointer(pointer, "/cameras/", "/perspective/yfov", index)) {
+        target = &pose.camera_yfov, objects = model.cameras.size(), label = "camera yfov";
+    } else if (indexed_pointer(pointer, "/extensions/KHR_lights_punctual/lights/", "/color", index)) {
+        target = &pose.light_color, objects = model.lights.size(), components = 3, label = "light color";
+    } else if (indexed_pointer(pointer, "/extensions/KHR_lights_punctual/lights/", "/intensity", index)) {
+        target = &pose.light_intensity, objects = model.lights.size(), label = "light intensity";
+    } else {
+        return false;
+    }
+    if (size_t(index) >= objects) reader.fail(ptr + "/target", "{} points at an object that does not exist", pointer);
+    if (ch.sampler < 0 || size_t(ch.sampler) >= model.animations[size_t(a)].samplers.size())
+        reader.fail(ptr + "/sampler", "sampler {} does not exist", ch.sampler);
+    // Scalars read like weights (SCALAR), colours like translations (VEC3).
+    const AnimationPath as = components == 1 ? AnimationPath::Weights : AnimationPath::Translation;
+    const AnimationSampler s = reader.read(a, ch.sampler, as, components, label);
+    std::vector<float> v(static_cast<size_t>(components));
+    sample_animation(s, as, float(t), v.data());
+    for (const float x : v)
+        if (target == &pose.camera_yfov ? !(x > 0.f && x < float(std::numbers::pi)) : !(x >= 0.f))
+            reader.fail(ptr, "{} is {} at {} s ({})", label, x, t,
+                        target == &pose.camera_yfov ? "yfov must be in (0, pi)" : "it must not be negative");
+    target->resize(objects);
+    (*target)[size_t(index)] = v;
+    return true;
 }
 
 /// "/nodes/N/translation" (rotation, scale, weights) as a node and a core path; false for others.
@@ -256,10 +306,12 @@ GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const
             if (ch.target_path == "pointer") {
                 // KHR_animation_pointer: the node properties a core channel could target.
                 const std::string pointer = animation_pointer(ch);
+                if (apply_object_pointer(model, reader, pointer, a, ch, ptr, t, pose)) continue;
                 if (!node_pointer(pointer, node, path_name)) {
                     warnings.add("animation-pointer:" + pointer,
                                  fmt::format("{}: KHR_animation_pointer target {} is not applied (whitted animates "
-                                             "/nodes/N/translation, rotation, scale and weights)",
+                                             "node translation, rotation, scale and weights, camera yfov, light "
+                                             "color and intensity)",
                                              animation_name(model, a), pointer.empty() ? "(none)" : pointer));
                     continue;
                 }

@@ -21,6 +21,8 @@ struct GltfPose {
     std::vector<Mat4d> local;                 ///< per node: its local transform
     std::vector<Mat4d> world;                 ///< per node: its global transform (every root of the file)
     std::vector<std::vector<float>> weights;  ///< per node: morph weights of its mesh (empty: no targets)
+    /// KHR_animation_pointer values, per camera / KHR_lights_punctual light (empty: as stored).
+    std::vector<std::vector<float>> camera_yfov, light_color, light_intensity;
 };
 
 /// The animations `choice` names: "all" (every one), a name, or indices "0,2". Throws
@@ -30,8 +32,9 @@ std::vector<int> choose_animations(const tinygltf::Model& model, const std::stri
 /// The nodes at `time` seconds under `animations` (each looping over its duration when `loop`),
 /// with morph weights from the animation, else node.weights, else mesh.weights, else 0. Validates
 /// what it reads and throws whitted::Error naming the file, the animation or node and the problem
-/// (key times, value counts, targets, weights counts). KHR_animation_pointer channels are skipped
-/// with a warning.
+/// (key times, value counts, targets, weights counts). KHR_animation_pointer channels apply to node
+/// translation, rotation, scale and weights, camera yfov and light color and intensity; others are
+/// skipped with one warning each.
 GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const std::vector<int>& animations,
                     double time, bool loop, WarningLog& warnings);
 

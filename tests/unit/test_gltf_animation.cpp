@@ -211,6 +211,42 @@ TEST(GltfAnimation, AnimationPointerToANodeAnimatesIt) {
     EXPECT_EQ(warned, 1u);
 }
 
+// KHR_animation_pointer to a camera's yfov and a light's color and intensity (LINEAR from 0 s to
+// 1 s, here at 0.5 s: halfway), and a yfov animated out of (0, pi) is an error naming the channel.
+TEST(GltfAnimation, AnimationPointerToCameraAndLight) {
+    auto file = [](float yfov_end) {
+        Glb b;
+        const int pos = b.floats(kTriangle, "VEC3", true);
+        const int in = b.floats({0, 1}, "SCALAR", true);
+        const int yfov = b.floats({0.5f, yfov_end}, "SCALAR");
+        const int color = b.floats({1, 1, 1, 0, 0.5f, 1}, "VEC3");
+        const int intensity = b.floats({0, 10}, "SCALAR");
+        return b.glb(fill(R"("scene":0,"scenes":[{"nodes":[0,1,2]}],"extensionsUsed":["KHR_animation_pointer","KHR_lights_punctual"],
+            "extensions":{"KHR_lights_punctual":{"lights":[{"type":"point","color":[1,1,1],"intensity":3}]}},
+            "cameras":[{"type":"perspective","perspective":{"yfov":0.5,"znear":0.1}}],
+            "nodes":[{"name":"tri","mesh":0},{"camera":0,"translation":[0,0,5]},
+                     {"extensions":{"KHR_lights_punctual":{"light":0}},"translation":[0,2,0]}],
+            "meshes":[{"primitives":[{"attributes":{"POSITION":@pos@}}]}],
+            "animations":[{"samplers":[{"input":@in@,"output":@yfov@},{"input":@in@,"output":@color@},
+                                       {"input":@in@,"output":@intensity@}],
+              "channels":[
+                {"sampler":0,"target":{"path":"pointer","extensions":{"KHR_animation_pointer":{"pointer":"/cameras/0/perspective/yfov"}}}},
+                {"sampler":1,"target":{"path":"pointer","extensions":{"KHR_animation_pointer":{"pointer":"/extensions/KHR_lights_punctual/lights/0/color"}}}},
+                {"sampler":2,"target":{"path":"pointer","extensions":{"KHR_animation_pointer":{"pointer":"/extensions/KHR_lights_punctual/lights/0/intensity"}}}}]}])",
+                                    {{"pos", pos}, {"in", in}, {"yfov", yfov}, {"color", color}, {"intensity", intensity}}));
+    };
+    const Scene s = import(file(1.0f), at_time(0.5));
+    ASSERT_EQ(s.cameras.size(), 1u);
+    EXPECT_NEAR(s.cameras[0].yfov, 0.75, 1e-6);
+    ASSERT_EQ(s.lights.size(), 1u);
+    EXPECT_VEC3_NEAR(s.lights[0].color, 0.5, 0.75, 1.0, 1e-6);
+    EXPECT_NEAR(s.lights[0].intensity, 5.0, 1e-5);
+    const Scene at0 = import(file(1.0f), at_time(0.0));
+    EXPECT_NEAR(at0.cameras[0].yfov, 0.5, 1e-6);
+    EXPECT_NEAR(at0.lights[0].intensity, 0.0, 1e-6);
+    expect_error([&] { import(file(4.0f), at_time(1.0)); }, "anim.glb", {"/animations/0/channels/0", "camera yfov", "(0, pi)"});
+}
+
 // Keys at 1 s and 2 s: before the first key the first value holds.
 TEST(GltfAnimation, BeforeTheFirstKeyTheFirstValueHolds) {
     const auto glb = animated_translation({1, 2}, {3, 0, 0, 5, 0, 0}, "LINEAR");
