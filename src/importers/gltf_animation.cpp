@@ -229,6 +229,48 @@ bool apply_object_pointer(const tinygltf::Model& model, const SamplerReader& rea
     return true;
 }
 
+/// The core material properties KHR_animation_pointer may animate here, with their components and range.
+struct MaterialProperty {
+    const char* path;
+    int components;
+    float lo, hi;
+};
+constexpr MaterialProperty kMaterialProperties[] = {
+    {"pbrMetallicRoughness/baseColorFactor", 4, 0.f, 1.f},
+    {"pbrMetallicRoughness/metallicFactor", 1, 0.f, 1.f},
+    {"pbrMetallicRoughness/roughnessFactor", 1, 0.f, 1.f},
+    {"emissiveFactor", 3, 0.f, 1.f},
+    {"alphaCutoff", 1, 0.f, 3.4e38f},
+    {"normalTexture/scale", 1, -3.4e38f, 3.4e38f},
+    {"occlusionTexture/strength", 1, 0.f, 1.f},
+};
+
+/// Applies a KHR_animation_pointer channel to a core material property ("/materials/N/..."); false
+/// when the pointer is not one of kMaterialProperties.
+bool apply_material_pointer(const tinygltf::Model& model, const SamplerReader& reader, const std::string& pointer,
+                            int a, const tinygltf::AnimationChannel& ch, const std::string& ptr, double t,
+                            GltfPose& pose) {
+    for (const MaterialProperty& p : kMaterialProperties) {
+        int index = -1;
+        if (!indexed_pointer(pointer, "/materials/", std::string("/") + p.path, index)) continue;
+        if (size_t(index) >= model.materials.size())
+            reader.fail(ptr + "/target", "{} points at a material that does not exist", pointer);
+        if (ch.sampler < 0 || size_t(ch.sampler) >= model.animations[size_t(a)].samplers.size())
+            reader.fail(ptr + "/sampler", "sampler {} does not exist", ch.sampler);
+        const AnimationPath as = p.components == 1   ? AnimationPath::Weights
+                                 : p.components == 3 ? AnimationPath::Translation
+                                                     : AnimationPath::Rotation;
+        AnimationSampler s = reader.read(a, ch.sampler, as, p.components, p.path);
+        std::vector<float> v(static_cast<size_t>(p.components));
+        // A colour of 4 is not a rotation: interpolated component by component.
+        sample_animation(s, as == AnimationPath::Rotation ? AnimationPath::Translation : as, float(t), v.data());
+        for (float& x : v) x = std::clamp(x, p.lo, p.hi);
+        pose.materials.push_back({index, p.path, std::move(v)});
+        return true;
+    }
+    return false;
+}
+
 /// "/nodes/N/translation" (rotation, scale, weights) as a node and a core path; false for others.
 bool node_pointer(const std::string& pointer, int& node, std::string& path) {
     const std::string prefix = "/nodes/";
@@ -307,11 +349,12 @@ GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const
                 // KHR_animation_pointer: the node properties a core channel could target.
                 const std::string pointer = animation_pointer(ch);
                 if (apply_object_pointer(model, reader, pointer, a, ch, ptr, t, pose)) continue;
+                if (apply_material_pointer(model, reader, pointer, a, ch, ptr, t, pose)) continue;
                 if (!node_pointer(pointer, node, path_name)) {
                     warnings.add("animation-pointer:" + pointer,
                                  fmt::format("{}: KHR_animation_pointer target {} is not applied (whitted animates "
                                              "node translation, rotation, scale and weights, camera yfov, light "
-                                             "color and intensity)",
+                                             "color and intensity, core material factors)",
                                              animation_name(model, a), pointer.empty() ? "(none)" : pointer));
                     continue;
                 }
@@ -377,6 +420,21 @@ GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const
         }
     }
     return pose;
+}
+
+void apply_material_values(const GltfPose& pose, tinygltf::Model& model) {
+    for (const GltfPose::MaterialValue& m : pose.materials) {
+        tinygltf::Material& g = model.materials[size_t(m.material)];
+        const std::vector<float>& v = m.value;
+        const std::vector<double> d(v.begin(), v.end());
+        if (m.property == "pbrMetallicRoughness/baseColorFactor") g.pbrMetallicRoughness.baseColorFactor = d;
+        else if (m.property == "pbrMetallicRoughness/metallicFactor") g.pbrMetallicRoughness.metallicFactor = d[0];
+        else if (m.property == "pbrMetallicRoughness/roughnessFactor") g.pbrMetallicRoughness.roughnessFactor = d[0];
+        else if (m.property == "emissiveFactor") g.emissiveFactor = d;
+        else if (m.property == "alphaCutoff") g.alphaCutoff = d[0];
+        else if (m.property == "normalTexture/scale") g.normalTexture.scale = d[0];
+        else if (m.property == "occlusionTexture/strength") g.occlusionTexture.strength = d[0];
+    }
 }
 
 bool deformed(const tinygltf::Model& model, int node, int primitive) {

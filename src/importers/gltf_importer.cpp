@@ -397,8 +397,8 @@ public:
         validate_gltf(m_model, m_path, m_options.max_memory, m_scene);
         check_images_present();
         classify_extensions();
-        convert_materials();
         pose();
+        convert_materials();
         traverse_scene();
         check_memory();
         build_meshes();
@@ -591,6 +591,7 @@ private:
     void pose() {
         m_animations = choose_animations(m_model, m_path, m_options.animation);
         m_pose = pose_nodes(m_model, m_path, m_animations, m_options.time, m_options.loop, m_warnings);
+        apply_material_values(m_pose, m_model);
         m_scene.time = m_options.time;
     }
 

@@ -186,7 +186,7 @@ TEST(GltfAnimation, LinearTranslationInterpolatesAndReplacesTheNodeTranslation) 
 
 // KHR_animation_pointer: a pointer to a node's translation animates it like a core channel (in a
 // GLB, whose JSON chunk is rewritten before tinygltf parses it); a pointer whitted does not apply
-// (a material factor) is one warning naming it, and the rest of the animation still applies.
+// (a texture transform) is one warning naming it, and the rest of the animation still applies.
 TEST(GltfAnimation, AnimationPointerToANodeAnimatesIt) {
     Glb b;
     const int pos = b.floats(kTriangle, "VEC3", true);
@@ -200,15 +200,45 @@ TEST(GltfAnimation, AnimationPointerToANodeAnimatesIt) {
           "channels":[{"sampler":0,"target":{"path":"pointer",
                          "extensions":{"KHR_animation_pointer":{"pointer":"/nodes/0/translation"}}}},
                       {"sampler":1,"target":{"path":"pointer",
-                         "extensions":{"KHR_animation_pointer":{"pointer":"/materials/0/pbrMetallicRoughness/baseColorFactor"}}}}]}])",
+                         "extensions":{"KHR_animation_pointer":{"pointer":"/materials/0/pbrMetallicRoughness/baseColorTexture/extensions/KHR_texture_transform/offset"}}}}]}])",
                                 {{"pos", pos}, {"in", in}, {"out", out}, {"color", color}}));
     EXPECT_VEC3_NEAR(translation_at(glb, 0.25), 0.5, 0.0, 0.0, 1e-6);
     const Scene s = import(glb, at_time(0.75));
     EXPECT_VEC3_NEAR(origin_of(instance_of(s, "tri").world_from_object), 1.5, 0.0, 0.0, 1e-6);
     size_t warned = 0;
     for (const std::string& w : s.warnings)
-        warned += w.find("/materials/0/pbrMetallicRoughness/baseColorFactor is not applied") != std::string::npos;
+        warned += w.find("KHR_texture_transform/offset is not applied") != std::string::npos;
     EXPECT_EQ(warned, 1u);
+}
+
+// KHR_animation_pointer to core material factors: baseColorFactor (VEC4, component by component,
+// not as a quaternion) and roughnessFactor, LINEAR over 0..1 s, halfway at 0.5 s; a value the
+// spline takes past the factor's range is clamped to it (roughness keys 0.2 and 1.4: 1 at 1 s).
+TEST(GltfAnimation, AnimationPointerToMaterialFactors) {
+    Glb b;
+    const int pos = b.floats(kTriangle, "VEC3", true);
+    const int in = b.floats({0, 1}, "SCALAR", true);
+    const int color = b.floats({1, 1, 1, 1, 0, 0.5f, 0, 1}, "VEC4");
+    const int rough = b.floats({0.2f, 1.4f}, "SCALAR");
+    const auto glb = b.glb(fill(R"("scene":0,"scenes":[{"nodes":[0]}],"extensionsUsed":["KHR_animation_pointer"],
+        "nodes":[{"name":"tri","mesh":0}],"materials":[{"pbrMetallicRoughness":{"roughnessFactor":0.7}}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":@pos@},"material":0}]}],
+        "animations":[{"samplers":[{"input":@in@,"output":@color@},{"input":@in@,"output":@rough@}],
+          "channels":[{"sampler":0,"target":{"path":"pointer",
+                         "extensions":{"KHR_animation_pointer":{"pointer":"/materials/0/pbrMetallicRoughness/baseColorFactor"}}}},
+                      {"sampler":1,"target":{"path":"pointer",
+                         "extensions":{"KHR_animation_pointer":{"pointer":"/materials/0/pbrMetallicRoughness/roughnessFactor"}}}}]}])",
+                                {{"pos", pos}, {"in", in}, {"color", color}, {"rough", rough}}));
+    const Scene half = import(glb, at_time(0.5));
+    ASSERT_GE(half.materials.size(), 1u);
+    EXPECT_NEAR(half.materials[0].base_color.x, 0.5, 1e-6);
+    EXPECT_NEAR(half.materials[0].base_color.y, 0.75, 1e-6);
+    EXPECT_NEAR(half.materials[0].base_color.z, 0.5, 1e-6);
+    EXPECT_NEAR(half.materials[0].base_color.w, 1.0, 1e-6);
+    EXPECT_NEAR(half.materials[0].roughness, 0.8, 1e-6);
+    const Scene end = import(glb, at_time(1.0));
+    EXPECT_NEAR(end.materials[0].roughness, 1.0, 1e-6);  // 1.4 clamped
+    for (const std::string& w : end.warnings) EXPECT_EQ(w.find("is not applied"), std::string::npos) << w;
 }
 
 // KHR_animation_pointer to a camera's yfov and a light's color and intensity (LINEAR from 0 s to
