@@ -168,28 +168,38 @@ FrameResult render_tiles(const RenderCommand& c, const FrameOptions& fo, const R
     return frame;
 }
 
+/// The rates a render's summary and metadata report.
+struct Rates {
+    double mrays = 0.0;       ///< million rays per second of the render phase
+    double per_pixel = 0.0;   ///< camera rays per pixel
+    double subdivided = 0.0;  ///< fraction of the pixels the adaptive mode split
+};
+
+Rates rates_of(const RenderStats& s) {
+    Rates r;
+    r.mrays = s.render_seconds > 0 ? double(s.rays.total()) / s.render_seconds * 1e-6 : 0.0;
+    r.per_pixel = s.pixels ? double(s.rays.camera) / double(s.pixels) : 0.0;
+    r.subdivided = s.pixels ? double(s.pixels_subdivided) / double(s.pixels) : 0.0;
+    return r;
+}
+
 /// One line of the whole run for the image's metadata.
 std::string stats_line(const Prepared& p, const RenderStats& stats, AaMode aa) {
-    const uint64_t rays = stats.rays.total();
-    const double mrays = stats.render_seconds > 0 ? double(rays) / stats.render_seconds * 1e-6 : 0.0;
-    const double per_pixel = stats.pixels ? double(stats.rays.camera) / double(stats.pixels) : 0.0;
-    const double subdivided = stats.pixels ? double(stats.pixels_subdivided) / double(stats.pixels) : 0.0;
+    const Rates r = rates_of(stats);
     return fmt::format(
         "time: load {:.3f}s, build {:.3f}s, render {:.3f}s | rays: {} camera, {} shadow, {} reflection, "
         "{} refraction, {} aov probe, {} total, {:.2f} Mrays/s on {} threads | aa: {} ({:.3f} camera rays/pixel, "
         "{:.1f}% pixels subdivided)",
         p.load_seconds, stats.build_seconds, stats.render_seconds, stats.rays.camera, stats.rays.shadow,
-        stats.rays.reflection, stats.rays.refraction, stats.rays.aov_probe, rays, mrays, stats.threads,
-        aa_mode_name(aa), per_pixel, 100.0 * subdivided);
+        stats.rays.reflection, stats.rays.refraction, stats.rays.aov_probe, stats.rays.total(), r.mrays,
+        stats.threads, aa_mode_name(aa), r.per_pixel, 100.0 * r.subdivided);
 }
 
 /// The summary on stderr after a finished frame: time split, rays by kind, what was skipped, speed.
 void print_summary(const RenderCommand& c, const Prepared& p, const FrameResult& frame, double write_seconds) {
     const RenderStats& s = frame.stats;
     const auto n = [](uint64_t v) { return (unsigned long long)v; };
-    const double mrays = s.render_seconds > 0 ? double(s.rays.total()) / s.render_seconds * 1e-6 : 0.0;
-    const double per_pixel = s.pixels ? double(s.rays.camera) / double(s.pixels) : 0.0;
-    const double subdivided = s.pixels ? double(s.pixels_subdivided) / double(s.pixels) : 0.0;
+    const Rates r = rates_of(s);
     std::fprintf(stderr,
                  "whitted: wrote %s (%dx%d)\n"
                  "  time   load %.3fs  build %.3fs  render %.3fs  write %.3fs\n"
@@ -203,8 +213,8 @@ void print_summary(const RenderCommand& c, const Prepared& p, const FrameResult&
                  n(s.rays.refraction), n(s.rays.total()), kernel_name(p.renderer->kernel()).c_str(),
                  n(s.rays.shadow_skipped_unreached), n(s.rays.shadow_skipped_facing), n(s.rays.shadow_skipped_zero),
                  n(s.rays.shadow_skipped_dim), double(c.render.integrator.min_weight),
-                 n(s.rays.secondary_skipped_cutoff), mrays, s.threads, aa_mode_name(c.render.aa.mode), per_pixel,
-                 100.0 * subdivided);
+                 n(s.rays.secondary_skipped_cutoff), r.mrays, s.threads, aa_mode_name(c.render.aa.mode), r.per_pixel,
+                 100.0 * r.subdivided);
 }
 
 /// Writes the frame (a partial one with its missing tiles listed) and returns the exit code: 0, or

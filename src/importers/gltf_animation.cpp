@@ -29,6 +29,15 @@ std::string animation_name(const tinygltf::Model& model, int a) {
     return n.empty() ? fmt::format("animation {}", a) : n;
 }
 
+/// An animation's duration: the last key time over its samplers (their input accessors' max).
+double animation_duration(const tinygltf::Model& model, const tinygltf::Animation& anim) {
+    double duration = 0.0;
+    for (const tinygltf::AnimationSampler& s : anim.samplers)
+        if (s.input >= 0 && size_t(s.input) < model.accessors.size() && !model.accessors[size_t(s.input)].maxValues.empty())
+            duration = std::max(duration, model.accessors[size_t(s.input)].maxValues[0]);
+    return duration;
+}
+
 /// Morph targets of a mesh: the largest count over its primitives (the spec wants them equal).
 size_t target_count(const tinygltf::Mesh& mesh) {
     size_t n = 0;
@@ -37,8 +46,8 @@ size_t target_count(const tinygltf::Mesh& mesh) {
 }
 
 /// A node's translation, rotation and scale (or its fixed matrix), which channels overwrite. Only
-/// the parts present (in the file or from a channel) are multiplied in, so a node nothing animates
-/// gets the matrix node_local_transform() gives, bit for bit.
+/// the parts present (in the file or from a channel) are multiplied in: a node nothing animates
+/// composes exactly its stored parts, with no identity factor in between.
 struct NodeTrs {
     std::array<double, 3> t{0, 0, 0};
     std::array<double, 4> r{0, 0, 0, 1};
@@ -273,18 +282,12 @@ bool apply_material_pointer(const tinygltf::Model& model, const SamplerReader& r
 
 /// "/nodes/N/translation" (rotation, scale, weights) as a node and a core path; false for others.
 bool node_pointer(const std::string& pointer, int& node, std::string& path) {
-    const std::string prefix = "/nodes/";
-    if (pointer.rfind(prefix, 0) != 0) return false;
-    const size_t slash = pointer.find('/', prefix.size());
-    if (slash == std::string::npos || slash == prefix.size()) return false;
-    const std::string index = pointer.substr(prefix.size(), slash - prefix.size());
-    if (index.size() > 9 || index.find_first_not_of("0123456789") != std::string::npos) return false;
-    const std::string property = pointer.substr(slash + 1);
-    if (property != "translation" && property != "rotation" && property != "scale" && property != "weights")
-        return false;
-    node = std::stoi(index);
-    path = property;
-    return true;
+    for (const char* property : {"translation", "rotation", "scale", "weights"})
+        if (indexed_pointer(pointer, "/nodes/", std::string("/") + property, node)) {
+            path = property;
+            return true;
+        }
+    return false;
 }
 
 }  // namespace
@@ -334,11 +337,7 @@ GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const
     const SamplerReader reader(model, path);
     for (const int a : animations) {
         const tinygltf::Animation& anim = model.animations[size_t(a)];
-        // Every sampler's last key: the animation's duration (for --loop).
-        double duration = 0.0;
-        for (const tinygltf::AnimationSampler& s : anim.samplers)
-            if (s.input >= 0 && size_t(s.input) < model.accessors.size() && !model.accessors[size_t(s.input)].maxValues.empty())
-                duration = std::max(duration, model.accessors[size_t(s.input)].maxValues[0]);
+        const double duration = animation_duration(model, anim);
         const double t = loop && duration > 0.0 ? std::fmod(time, duration) : time;
         for (size_t c = 0; c < anim.channels.size(); ++c) {
             const tinygltf::AnimationChannel& ch = anim.channels[c];
@@ -401,8 +400,6 @@ GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const
         }
     }
     // Global transforms over the whole node forest: joints outside the rendered scene are posed too.
-    pose.local.resize(count);
-    for (size_t n = 0; n < count; ++n) pose.local[n] = trs[n].local();
     std::vector<int> parent(count, -1);
     for (size_t n = 0; n < count; ++n)
         for (const int c : model.nodes[n].children)
@@ -415,7 +412,7 @@ GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const
         for (int k = int(n); k >= 0 && !done[size_t(k)]; k = parent[size_t(k)]) chain.push_back(k);
         for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
             const int k = *it, up = parent[size_t(k)];
-            pose.world[size_t(k)] = up >= 0 ? pose.world[size_t(up)] * pose.local[size_t(k)] : pose.local[size_t(k)];
+            pose.world[size_t(k)] = (up >= 0 ? pose.world[size_t(up)] : Mat4d::identity()) * trs[size_t(k)].local();
             done[size_t(k)] = 1;
         }
     }
@@ -568,12 +565,9 @@ void describe_animation(const tinygltf::Model& model, const std::vector<int>& po
         AnimationInfo info;
         info.name = animation_name(model, int(a));
         info.channels = anim.channels.size();
+        info.duration = float(animation_duration(model, anim));
         std::set<std::string> kinds;
-        for (const tinygltf::AnimationSampler& s : anim.samplers) {
-            kinds.insert(s.interpolation.empty() ? "LINEAR" : s.interpolation);
-            if (s.input >= 0 && size_t(s.input) < model.accessors.size() && !model.accessors[size_t(s.input)].maxValues.empty())
-                info.duration = std::max(info.duration, float(model.accessors[size_t(s.input)].maxValues[0]));
-        }
+        for (const tinygltf::AnimationSampler& s : anim.samplers) kinds.insert(s.interpolation.empty() ? "LINEAR" : s.interpolation);
         for (const std::string& k : kinds) {
             if (!info.interpolations.empty()) info.interpolations += ',';
             info.interpolations += k;

@@ -18,7 +18,6 @@ namespace whitted {
 
 /// Every node of a file at one time: what the traversal and the mesh deformation read.
 struct GltfPose {
-    std::vector<Mat4d> local;                 ///< per node: its local transform
     std::vector<Mat4d> world;                 ///< per node: its global transform (every root of the file)
     std::vector<std::vector<float>> weights;  ///< per node: morph weights of its mesh (empty: no targets)
     /// KHR_animation_pointer values, per camera / KHR_lights_punctual light (empty: as stored).

@@ -972,31 +972,27 @@ private:
                 if (!is_child[i]) roots.push_back(int(i));
             m_warnings.add("no-scene", "the file defines no scene: every root node is shown");
         }
-        // Depth-first, pre-order, children in file order (this is the camera and light order).
-        struct Item {
-            int node;
-            Mat4d parent;
-        };
-        std::vector<Item> stack;
-        for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, Mat4d::identity()});
+        // Depth-first, pre-order, children in file order (this is the camera and light order); the
+        // world transforms are the pose's (scene roots are roots of the node forest).
+        std::vector<int> stack(roots.rbegin(), roots.rend());
         while (!stack.empty()) {
-            const Item item = stack.back();
+            const int n = stack.back();
             stack.pop_back();
-            const tinygltf::Node& node = m_model.nodes[size_t(item.node)];
-            const Mat4d world = item.parent * m_pose.local[size_t(item.node)];
+            const tinygltf::Node& node = m_model.nodes[size_t(n)];
+            const Mat4d& world = m_pose.world[size_t(n)];
             if (node.mesh >= 0) {
                 if (const tinygltf::Value* gi = find_extension(node.extensions, "EXT_mesh_gpu_instancing"))
-                    place_gpu_instances(item.node, node.mesh, world, gi);
+                    place_gpu_instances(n, node.mesh, world, gi);
                 else
-                    place_mesh(item.node, node_label(m_model, item.node), node.mesh, world);
+                    place_mesh(n, node_label(m_model, n), node.mesh, world);
             }
-            if (node.camera >= 0) place_camera(item.node, world);
+            if (node.camera >= 0) place_camera(n, world);
             if (const tinygltf::Value* lp = find_extension(node.extensions, "KHR_lights_punctual")) {
                 int light = -1;
                 as_int(find_member(lp, "light"), light);
-                place_light(item.node, light, world);
+                place_light(n, light, world);
             }
-            for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back({*c, world});
+            for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back(*c);
         }
     }
 
