@@ -202,39 +202,52 @@ bool indexed_pointer(const std::string& pointer, const std::string& prefix, cons
     return true;
 }
 
+/// The value at time `t` of a KHR_animation_pointer channel's sampler: `components` floats (a
+/// SCALAR or VEC3/VEC4 accessor), interpolated component by component; `label` names the property.
+std::vector<float> sample_pointer(const tinygltf::Model& model, const SamplerReader& reader, int a,
+                                  const tinygltf::AnimationChannel& ch, const std::string& ptr, double t,
+                                  int components, const char* label) {
+    if (ch.sampler < 0 || size_t(ch.sampler) >= model.animations[size_t(a)].samplers.size())
+        reader.fail(ptr + "/sampler", "sampler {} does not exist", ch.sampler);
+    const AnimationPath as = components == 1   ? AnimationPath::Weights      // a SCALAR accessor
+                             : components == 3 ? AnimationPath::Translation  // VEC3
+                                               : AnimationPath::Rotation;    // VEC4
+    const AnimationSampler s = reader.read(a, ch.sampler, as, components, label);
+    std::vector<float> v(static_cast<size_t>(components));
+    // Not a rotation: no quaternion interpolation for 4 components.
+    sample_animation(s, as == AnimationPath::Rotation ? AnimationPath::Translation : as, float(t), v.data());
+    return v;
+}
+
 /// Applies a KHR_animation_pointer channel to a camera's yfov or a light's color or intensity;
 /// false when the pointer is not one of those.
 bool apply_object_pointer(const tinygltf::Model& model, const SamplerReader& reader, const std::string& pointer,
                           int a, const tinygltf::AnimationChannel& ch, const std::string& ptr, double t,
                           GltfPose& pose) {
     int index = -1;
-    std::vector<std::vector<float>>* target = nullptr;
     size_t objects = 0;
     int components = 1;
     const char* label = "";
+    GltfPose::Collection collection = GltfPose::Collection::Lights;
+    const char* property = "";
     if (indexed_pointer(pointer, "/cameras/", "/perspective/yfov", index)) {
-        target = &pose.camera_yfov, objects = model.cameras.size(), label = "camera yfov";
+        collection = GltfPose::Collection::Cameras, objects = model.cameras.size(), label = "camera yfov",
+        property = "perspective/yfov";
     } else if (indexed_pointer(pointer, "/extensions/KHR_lights_punctual/lights/", "/color", index)) {
-        target = &pose.light_color, objects = model.lights.size(), components = 3, label = "light color";
+        objects = model.lights.size(), components = 3, label = "light color", property = "color";
     } else if (indexed_pointer(pointer, "/extensions/KHR_lights_punctual/lights/", "/intensity", index)) {
-        target = &pose.light_intensity, objects = model.lights.size(), label = "light intensity";
+        objects = model.lights.size(), label = "light intensity", property = "intensity";
     } else {
         return false;
     }
     if (size_t(index) >= objects) reader.fail(ptr + "/target", "{} points at an object that does not exist", pointer);
-    if (ch.sampler < 0 || size_t(ch.sampler) >= model.animations[size_t(a)].samplers.size())
-        reader.fail(ptr + "/sampler", "sampler {} does not exist", ch.sampler);
-    // Scalars read like weights (SCALAR), colours like translations (VEC3).
-    const AnimationPath as = components == 1 ? AnimationPath::Weights : AnimationPath::Translation;
-    const AnimationSampler s = reader.read(a, ch.sampler, as, components, label);
-    std::vector<float> v(static_cast<size_t>(components));
-    sample_animation(s, as, float(t), v.data());
+    std::vector<float> v = sample_pointer(model, reader, a, ch, ptr, t, components, label);
+    const bool yfov = collection == GltfPose::Collection::Cameras;
     for (const float x : v)
-        if (target == &pose.camera_yfov ? !(x > 0.f && x < float(std::numbers::pi)) : !(x >= 0.f))
+        if (yfov ? !(x > 0.f && x < float(std::numbers::pi)) : !(x >= 0.f))
             reader.fail(ptr, "{} is {} at {} s ({})", label, x, t,
-                        target == &pose.camera_yfov ? "yfov must be in (0, pi)" : "it must not be negative");
-    target->resize(objects);
-    (*target)[size_t(index)] = v;
+                        yfov ? "yfov must be in (0, pi)" : "it must not be negative");
+    pose.values.push_back({collection, index, property, std::move(v)});
     return true;
 }
 
@@ -264,17 +277,9 @@ bool apply_material_pointer(const tinygltf::Model& model, const SamplerReader& r
         if (!indexed_pointer(pointer, "/materials/", std::string("/") + p.path, index)) continue;
         if (size_t(index) >= model.materials.size())
             reader.fail(ptr + "/target", "{} points at a material that does not exist", pointer);
-        if (ch.sampler < 0 || size_t(ch.sampler) >= model.animations[size_t(a)].samplers.size())
-            reader.fail(ptr + "/sampler", "sampler {} does not exist", ch.sampler);
-        const AnimationPath as = p.components == 1   ? AnimationPath::Weights
-                                 : p.components == 3 ? AnimationPath::Translation
-                                                     : AnimationPath::Rotation;
-        AnimationSampler s = reader.read(a, ch.sampler, as, p.components, p.path);
-        std::vector<float> v(static_cast<size_t>(p.components));
-        // A colour of 4 is not a rotation: interpolated component by component.
-        sample_animation(s, as == AnimationPath::Rotation ? AnimationPath::Translation : as, float(t), v.data());
+        std::vector<float> v = sample_pointer(model, reader, a, ch, ptr, t, p.components, p.path);
         for (float& x : v) x = std::clamp(x, p.lo, p.hi);
-        pose.materials.push_back({index, p.path, std::move(v)});
+        pose.values.push_back({GltfPose::Collection::Materials, index, p.path, std::move(v)});
         return true;
     }
     return false;
@@ -419,11 +424,20 @@ GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const
     return pose;
 }
 
-void apply_material_values(const GltfPose& pose, tinygltf::Model& model) {
-    for (const GltfPose::MaterialValue& m : pose.materials) {
-        tinygltf::Material& g = model.materials[size_t(m.material)];
-        const std::vector<float>& v = m.value;
-        const std::vector<double> d(v.begin(), v.end());
+void apply_pointer_values(const GltfPose& pose, tinygltf::Model& model) {
+    for (const GltfPose::PointerValue& m : pose.values) {
+        const std::vector<double> d(m.value.begin(), m.value.end());
+        if (m.collection == GltfPose::Collection::Cameras) {
+            model.cameras[size_t(m.index)].perspective.yfov = d[0];
+            continue;
+        }
+        if (m.collection == GltfPose::Collection::Lights) {
+            tinygltf::Light& l = model.lights[size_t(m.index)];
+            if (m.property == "color") l.color = d;
+            else l.intensity = d[0];
+            continue;
+        }
+        tinygltf::Material& g = model.materials[size_t(m.index)];
         if (m.property == "pbrMetallicRoughness/baseColorFactor") g.pbrMetallicRoughness.baseColorFactor = d;
         else if (m.property == "pbrMetallicRoughness/metallicFactor") g.pbrMetallicRoughness.metallicFactor = d[0];
         else if (m.property == "pbrMetallicRoughness/roughnessFactor") g.pbrMetallicRoughness.roughnessFactor = d[0];

@@ -20,20 +20,22 @@ namespace whitted {
 struct GltfPose {
     std::vector<Mat4d> world;                 ///< per node: its global transform (every root of the file)
     std::vector<std::vector<float>> weights;  ///< per node: morph weights of its mesh (empty: no targets)
-    /// KHR_animation_pointer values, per camera / KHR_lights_punctual light (empty: as stored).
-    std::vector<std::vector<float>> camera_yfov, light_color, light_intensity;
-    /// KHR_animation_pointer values of material properties: "/materials/N/<property>" and its value.
-    struct MaterialValue {
-        int material = -1;
-        std::string property;  ///< "pbrMetallicRoughness/baseColorFactor", "emissiveFactor", ...
+    /// KHR_animation_pointer values of properties outside the nodes: which object, which property
+    /// below it ("perspective/yfov", "color", "pbrMetallicRoughness/baseColorFactor", ...), the value.
+    enum class Collection { Cameras, Lights, Materials };
+    struct PointerValue {
+        Collection collection = Collection::Materials;
+        int index = -1;
+        std::string property;
         std::vector<float> value;
     };
-    std::vector<MaterialValue> materials;
+    std::vector<PointerValue> values;
 };
 
-/// Writes the pose's animated material properties into `model` (before its materials are read),
-/// each clamped to its glTF range (a spline may overshoot its keys).
-void apply_material_values(const GltfPose& pose, tinygltf::Model& model);
+/// Writes the pose's animated camera, light and material properties into `model` before the
+/// importer reads them (material factors already clamped to their glTF range: a spline may
+/// overshoot its keys).
+void apply_pointer_values(const GltfPose& pose, tinygltf::Model& model);
 
 /// The animations `choice` names: "all" (every one), a name, or indices "0,2". Throws
 /// whitted::Error naming the file and listing the animations it has when one does not exist.
@@ -44,7 +46,8 @@ std::vector<int> choose_animations(const tinygltf::Model& model, const std::stri
 /// what it reads and throws whitted::Error naming the file, the animation or node and the problem
 /// (key times, value counts, targets, weights counts). KHR_animation_pointer channels apply to node
 /// translation, rotation, scale and weights, camera yfov, light color and intensity, and the core
-/// material factors (apply_material_values); others are skipped with one warning each.
+/// material factors (written into the model by apply_pointer_values); others are skipped with one
+/// warning each.
 GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const std::vector<int>& animations,
                     double time, bool loop, WarningLog& warnings);
 

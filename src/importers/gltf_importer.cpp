@@ -591,7 +591,7 @@ private:
     void pose() {
         m_animations = choose_animations(m_model, m_path, m_options.animation);
         m_pose = pose_nodes(m_model, m_path, m_animations, m_options.time, m_options.loop, m_warnings);
-        apply_material_values(m_pose, m_model);
+        apply_pointer_values(m_pose, m_model);
         m_scene.time = m_options.time;
     }
 
@@ -903,12 +903,9 @@ private:
         const tinygltf::Camera& g = m_model.cameras[size_t(m_model.nodes[size_t(node)].camera)];
         Camera c;
         c.name = !g.name.empty() ? g.name : node_label(m_model, node);
-        const size_t index = size_t(m_model.nodes[size_t(node)].camera);
         if (g.type == "perspective") {
             c.type = CameraType::Perspective;
-            c.yfov = index < m_pose.camera_yfov.size() && !m_pose.camera_yfov[index].empty()
-                         ? double(m_pose.camera_yfov[index][0])  // KHR_animation_pointer
-                         : g.perspective.yfov;
+            c.yfov = g.perspective.yfov;
             c.aspect = g.perspective.aspectRatio;
             c.znear = g.perspective.znear;
             c.zfar = g.perspective.zfar;
@@ -934,13 +931,6 @@ private:
         if (g.color.size() == 3) l.color = {float(g.color[0]), float(g.color[1]), float(g.color[2])};
         // Renderer units are candela (point, spot) and lux (directional): see docs/lights.md.
         l.intensity = float(g.intensity);
-        // Animated through KHR_animation_pointer.
-        if (size_t(light) < m_pose.light_color.size() && !m_pose.light_color[size_t(light)].empty()) {
-            const std::vector<float>& c = m_pose.light_color[size_t(light)];
-            l.color = {c[0], c[1], c[2]};
-        }
-        if (size_t(light) < m_pose.light_intensity.size() && !m_pose.light_intensity[size_t(light)].empty())
-            l.intensity = m_pose.light_intensity[size_t(light)][0];
         l.range = float(g.range);
         if (l.type == LightType::Spot) {
             l.inner_cone = float(g.spot.innerConeAngle);
