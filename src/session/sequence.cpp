@@ -36,7 +36,8 @@ std::string frame_path(const std::string& pattern, int frame) {
     if (end == std::string::npos)
         throw Error(fmt::format("--frames: the output name {} has no '#' for the frame number (e.g. out_####.exr)",
                                 pattern));
-    const size_t begin = pattern.find_last_not_of('#', end) == std::string::npos ? 0 : pattern.find_last_not_of('#', end) + 1;
+    const size_t before = pattern.find_last_not_of('#', end);  // npos: the run starts the name
+    const size_t begin = before == std::string::npos ? 0 : before + 1;
     const size_t width = end + 1 - begin;
     return pattern.substr(0, begin) + fmt::format("{:0{}d}", frame, width) + pattern.substr(end + 1);
 }
