@@ -26,6 +26,7 @@
 
 #include "core/ray_offset.h"
 #include "core/vecmath.h"
+#include "scene/scene_update.h"
 
 namespace whitted {
 
@@ -144,6 +145,16 @@ public:
     /// crossing counts once (de-duplicated per (geom, inst) within a few-ulp t window). Returns
     /// exactly 0 as soon as an opaque surface is found.
     virtual Color transmittance(const Ray& ray) const = 0;
+    /// Brings the structure up to date after the scene it was built from changed in place as
+    /// `update` says (scene_update.h): deformed meshes refit, moved instances placed again, the rest
+    /// untouched. Returns false when the backend cannot (the default; the caller then builds a new
+    /// one). After it, every query answers as a new build over the changed scene would (the hits
+    /// the same, whatever the tree's shape: exact ties follow the tie rule). Not concurrent with
+    /// queries.
+    virtual bool update(const SceneUpdate& update) {
+        (void)update;
+        return false;
+    }
     /// Backend name as given to create_accelerator.
     virtual std::string name() const = 0;
     virtual AccelStats stats() const = 0;

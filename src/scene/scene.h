@@ -34,6 +34,9 @@ struct Mesh {
     std::vector<Vec4f> colors;        ///< COLOR_0 as linear RGBA; may be empty
     std::vector<uint32_t> indices;    ///< 3 per triangle, counter-clockwise front faces
     uint32_t material = 0;            ///< index into Scene::materials
+    bool deforming = false;           ///< an animation moves its vertices (skin, morph weights): between
+                                      ///< frames they are rewritten in place, and accelerators keep the
+                                      ///< mesh apart, built to be refit (scene_update.h)
 
     size_t triangle_count() const { return indices.size() / 3; }
     /// Object-space bounds of the positions (computed, not cached).
@@ -50,6 +53,8 @@ struct Instance {
     Mat4d world_from_object;          ///< composed in double precision from the node hierarchy
     std::string node_name;            ///< the glTF node (or scene-file entry) it came from
     int32_t node = -1;                ///< glTF node index, -1 when not from a glTF node
+    bool moving = false;              ///< an animation changes world_from_object: accelerators keep it
+                                      ///< out of the flattened static geometry (scene_update.h)
 };
 
 /// Analytic sphere (scene files), intersected by its quadratic in every backend. Shading UVs:

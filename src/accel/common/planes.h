@@ -79,6 +79,9 @@ public:
         }
     }
 
+    /// Planes do not move (scene_update.h): the backend's update.
+    bool update(const SceneUpdate& update) override { return m_inner->update(update); }
+
     Color transmittance(const Ray& ray) const override {
         if (!ray_is_traceable(ray)) return Color(1.f);
         Color tr(1.f);
