@@ -66,6 +66,7 @@ void write_tile_log(const std::string& path, const FrameResult& frame, const std
 /// A render set up: the scene, what the pixels depend on, the renderer.
 struct Prepared {
     Scene scene;
+    std::unique_ptr<SceneAnimator> animator;  ///< a sequence's: poses the scene at each frame's time
     double load_seconds = 0.0;
     SettingList identity;  ///< recorded by checkpoints and tile-job parts, checked by --resume and merge
     std::unique_ptr<Renderer> renderer;
@@ -86,15 +87,22 @@ void apply_tile_job(RenderCommand& c, const Scene& scene, const SettingList& ide
     c.out.exr_half = false;  // exact: the merged frame is bit-identical to a one-piece render
 }
 
-/// Loads the scene, lets its settings fill what the flags did not set, checks the colour pipeline,
-/// lets `adjust` change the scene (a sequence's camera) and builds the renderer.
+/// Loads the scene (with `animated`, keeping its animator), lets its settings fill what the flags
+/// did not set, checks the colour pipeline, lets `adjust` change the scene (a sequence's camera)
+/// and builds the renderer.
 void prepare(RenderCommand& c, const SettingGiven& given, Prepared& p,
-             const std::function<void(Scene&, const RenderSettings&)>& adjust = {}) {
+             const std::function<void(Prepared&, const RenderSettings&)>& adjust = {}, bool animated = false) {
     RenderSettings& rs = c.render;
     const auto t_load = Clock::now();
     c.import.max_memory = size_t(c.max_memory_gb * double(size_t(1) << 30));
     set_accelerator_memory_limit(c.import.max_memory);
-    p.scene = load_scene(c.input, c.import);
+    if (animated) {
+        AnimatedScene a = load_animated_scene(c.input, c.import);
+        p.scene = std::move(a.scene);
+        p.animator = std::move(a.animator);
+    } else {
+        p.scene = load_scene(c.input, c.import);
+    }
     p.load_seconds = seconds_since(t_load);
     for (const std::string& w : p.scene.warnings) log_warning("{}: {}", c.input, w);
 
@@ -109,7 +117,7 @@ void prepare(RenderCommand& c, const SettingGiven& given, Prepared& p,
     for (auto& kv : describe_import_options(c.import)) p.identity.push_back(kv);
     for (auto& kv : describe_image_settings(rs)) p.identity.push_back(kv);
     if (!c.tile_job.empty()) apply_tile_job(c, p.scene, p.identity);
-    if (adjust) adjust(p.scene, rs);
+    if (adjust) adjust(p, rs);
     p.renderer = std::make_unique<Renderer>(p.scene, rs);
 }
 
@@ -256,27 +264,22 @@ int write_frame(RenderCommand& c, const Prepared& p, const FrameResult& frame, c
     return 0;
 }
 
-/// The bounds of every frame of a sequence when its camera is the default one (which then frames
-/// them all and stays fixed), else nothing: each frame loaded without textures or environment.
-std::optional<Bounds3d> sequence_bounds(const RenderCommand& c, const SettingGiven& given, const FrameRange& range) {
-    std::optional<Bounds3d> all;
-    for (int k = range.first; k <= range.last; ++k) {
-        ImportOptions io = c.import;
-        io.time = frame_time(k, range.fps);
-        io.load_textures = false;
-        io.no_environment = true;
-        const Scene scene = load_scene(c.input, io);
-        RenderSettings rs = c.render;
-        apply_scene_settings(scene.settings, rs, given);
-        if (rs.camera < 0 || size_t(rs.camera) >= scene.cameras.size() || !scene.cameras[size_t(rs.camera)].is_default)
-            return std::nullopt;
-        if (!all) all = Bounds3d{};
-        all->extend(scene.world_bounds());
+/// The bounds of every frame of a sequence, when its camera is the default one (which then frames
+/// them all and stays fixed), else nothing: the scene posed at each frame, then at the first again.
+std::optional<Bounds3d> sequence_bounds(Prepared& p, const RenderSettings& rs, const FrameRange& range) {
+    if (rs.camera < 0 || size_t(rs.camera) >= p.scene.cameras.size() || !p.scene.cameras[size_t(rs.camera)].is_default)
+        return std::nullopt;
+    Bounds3d all = p.scene.world_bounds();
+    for (int k = range.first + 1; k <= range.last; ++k) {
+        p.animator->pose(p.scene, frame_time(k, range.fps));
+        all.extend(p.scene.world_bounds());
     }
+    if (range.count() > 1) p.animator->pose(p.scene, frame_time(range.first, range.fps));
     return all;
 }
 
-/// `render --frames A-B`: every frame rendered and written like a single image, at time k / fps.
+/// `render --frames A-B`: the scene loaded once and posed at each frame's time k / fps (only what
+/// moves is updated: Renderer::update), every frame rendered and written like a single image.
 int run_sequence(const RenderCommand& c0, const std::string& cmdline, const SettingGiven& given, MpiSession* mpi) {
     FrameRange range = parse_frame_range(c0.frames);
     range.fps = c0.fps;
@@ -286,19 +289,42 @@ int run_sequence(const RenderCommand& c0, const std::string& cmdline, const Sett
     if (!c0.tile_job.empty() || c0.resume || c0.checkpoint_seconds > 0)
         throw Error("--frames: --tile-job, --checkpoint and --resume apply to one image, not to a sequence");
     install_interrupt_handlers();
-    const std::optional<Bounds3d> bounds = sequence_bounds(c0, given, range);
+    std::optional<Bounds3d> bounds;
+    // The default camera of frame k: framing every frame's bounds, turned by its share of --orbit.
+    const auto place_camera = [&](Prepared& p, const RenderSettings& rs, int k) {
+        if (!bounds) return false;
+        p.scene.cameras[size_t(rs.camera)] = default_camera(*bounds, c0.orbit * double(k - range.first) / double(range.count()));
+        return true;
+    };
+    RenderCommand c = c0;
+    c.import.time = frame_time(range.first, range.fps);
+    Prepared p;
+    prepare(c, given, p, [&](Prepared& prepared, const RenderSettings& rs) {
+        bounds = sequence_bounds(prepared, rs, range);
+        place_camera(prepared, rs, range.first);
+    }, true);
     if (c0.orbit != 0.0 && !bounds) log_warning("--orbit turns the default camera only: the file's camera is used");
+    log_scene(c, p.scene, *p.renderer);
     for (int k = range.first; k <= range.last; ++k) {
         if (interrupts().signals.load() > 0) return 128 + interrupts().last_signal.load();
-        RenderCommand c = c0;
         c.import.time = frame_time(k, range.fps);
         c.output = frame_path(c0.output, k);
-        const double turn = c0.orbit * double(k - range.first) / double(range.count());
-        Prepared p;
-        prepare(c, given, p, [&](Scene& scene, const RenderSettings& rs) {
-            if (bounds) scene.cameras[size_t(rs.camera)] = default_camera(*bounds, turn);
-        });
-        if (k == range.first) log_scene(c, p.scene, *p.renderer);
+        if (k > range.first) {
+            const size_t warned = p.scene.warnings.size();
+            const auto t_pose = Clock::now();
+            SceneUpdate u = p.animator->pose(p.scene, c.import.time);
+            p.load_seconds = seconds_since(t_pose);
+            u.cameras |= place_camera(p, c.render, k);
+            if (u.reloaded) {
+                p.renderer = std::make_unique<Renderer>(p.scene, c.render);
+            } else {
+                const Renderer::Update done = p.renderer->update(u);
+                log_debug("frame {}: {} meshes and {} instances moved, accelerator {} in {:.3f}s", k, u.meshes.size(),
+                          u.instances.size(), done.refit ? "refit" : "rebuilt", done.seconds);
+            }
+            for (size_t w = u.reloaded ? 0 : warned; w < p.scene.warnings.size(); ++w)
+                log_warning("{}: {}", c.input, p.scene.warnings[w]);
+        }
         FrameOptions fo = frame_options(c, p.identity, *p.renderer);
         fo.checkpoint_path.clear();  // a sequence keeps no checkpoint
         const FrameResult frame = render_tiles(c, fo, *p.renderer, nullptr);

@@ -335,6 +335,8 @@ GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const
     std::vector<NodeTrs> trs(count);
     GltfPose pose;
     pose.weights.resize(count);
+    pose.moving.assign(count, 0);
+    pose.morphing.assign(count, 0);
     for (size_t n = 0; n < count; ++n) {
         trs[n] = node_trs(model.nodes[n]);
         pose.weights[n] = default_weights(model, path, int(n));
@@ -390,6 +392,7 @@ GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const
             std::vector<float> v(static_cast<size_t>(components));
             sample_animation(s, p, float(t), v.data());
             NodeTrs& n = trs[size_t(node)];
+            (p == AnimationPath::Weights ? pose.morphing : pose.moving)[size_t(node)] = 1;
             if (p == AnimationPath::Translation) {
                 n.t = {v[0], v[1], v[2]};
                 n.has_t = true;
@@ -418,6 +421,7 @@ GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const
         for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
             const int k = *it, up = parent[size_t(k)];
             pose.world[size_t(k)] = (up >= 0 ? pose.world[size_t(up)] : Mat4d::identity()) * trs[size_t(k)].local();
+            if (up >= 0) pose.moving[size_t(k)] |= pose.moving[size_t(up)];
             done[size_t(k)] = 1;
         }
     }
@@ -453,6 +457,15 @@ bool deformed(const tinygltf::Model& model, int node, int primitive) {
     if (n.mesh < 0) return false;
     const tinygltf::Primitive& p = model.meshes[size_t(n.mesh)].primitives[size_t(primitive)];
     return !p.targets.empty() || (n.skin >= 0 && p.attributes.count("JOINTS_0") && p.attributes.count("WEIGHTS_0"));
+}
+
+bool deforming(const tinygltf::Model& model, int node, const GltfPose& pose) {
+    if (pose.morphing[size_t(node)]) return true;
+    const int skin = model.nodes[size_t(node)].skin;
+    if (skin < 0) return false;
+    for (const int j : model.skins[size_t(skin)].joints)
+        if (j >= 0 && size_t(j) < pose.moving.size() && pose.moving[size_t(j)]) return true;
+    return false;
 }
 
 namespace {

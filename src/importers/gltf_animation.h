@@ -20,6 +20,9 @@ namespace whitted {
 struct GltfPose {
     std::vector<Mat4d> world;                 ///< per node: its global transform (every root of the file)
     std::vector<std::vector<float>> weights;  ///< per node: morph weights of its mesh (empty: no targets)
+    std::vector<uint8_t> moving;              ///< per node: a chosen animation changes its global transform
+                                              ///< (a channel on its translation, rotation or scale, or an ancestor's)
+    std::vector<uint8_t> morphing;            ///< per node: a chosen animation changes its morph weights
     /// KHR_animation_pointer values of properties outside the nodes: which object, which property
     /// below it ("perspective/yfov", "color", "pbrMetallicRoughness/baseColorFactor", ...), the value.
     enum class Collection { Cameras, Lights, Materials };
@@ -53,6 +56,10 @@ GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const
 
 /// True when node `node`'s primitive needs a mesh of its own: it has a skin, or morph targets.
 bool deformed(const tinygltf::Model& model, int node, int primitive);
+
+/// True when that deformation changes over time under `pose`'s animations: its morph weights are
+/// animated, or one of its skin's joints moves.
+bool deforming(const tinygltf::Model& model, int node, const GltfPose& pose);
 
 /// Deforms `mesh`, built from `primitive` of node `node`'s mesh, to the pose: morph targets first
 /// (POSITION, NORMAL, TANGENT displacements times the node's weights), then the skin (each vertex by

@@ -409,7 +409,80 @@ public:
         return std::move(m_scene);
     }
 
+    /// `scene` (what run() returned, as the last call left it) posed at `time` in place, as run()
+    /// would have built it at that time: instance transforms, deforming meshes' vertices (positions
+    /// in their own allocation), the file's cameras and lights, animated material factors. Nothing
+    /// when the node graph's structure changed (an instance now needs another mesh: a transform
+    /// turned mirroring); the caller imports the file again.
+    std::optional<SceneUpdate> repose(Scene& scene, double time) {
+        m_options.time = time;
+        WarningLog log;
+        std::swap(log, m_warnings);
+        m_pose = pose_nodes(m_model, m_path, m_animations, time, m_options.loop, m_warnings);
+        apply_pointer_values(m_pose, m_model);
+        SceneUpdate u;
+        // The traversal and the material conversion write into a scratch scene.
+        m_scene = Scene{};
+        const bool materials = std::any_of(m_pose.values.begin(), m_pose.values.end(), [](const auto& v) {
+            return v.collection == GltfPose::Collection::Materials;
+        });
+        if (materials) {
+            convert_materials();  // the same textures: texture_index() finds each in m_texture_map
+            std::copy(m_scene.materials.begin(), m_scene.materials.end(), scene.materials.begin());
+            u.materials = true;
+        }
+        const size_t requests = m_requests.size();
+        traverse_scene();
+        if (m_requests.size() != requests || m_scene.instances.size() != scene.instances.size() ||
+            m_scene.cameras.size() > scene.cameras.size() || m_scene.lights.size() > scene.lights.size())
+            return std::nullopt;
+        for (size_t i = 0; i < scene.instances.size(); ++i) {
+            const Instance& now = m_scene.instances[i];
+            Instance& was = scene.instances[i];
+            if (now.mesh != was.mesh) return std::nullopt;
+            if (now.world_from_object == was.world_from_object) continue;
+            was.world_from_object = now.world_from_object;
+            u.instances.push_back(uint32_t(i));
+        }
+        repose_meshes(scene, u);
+        // The file's cameras and lights come first (the defaults and the environment's lights after).
+        std::copy(m_scene.cameras.begin(), m_scene.cameras.end(), scene.cameras.begin());
+        if (m_scene.cameras.empty() && !scene.cameras.empty() && scene.cameras[0].is_default)
+            scene.cameras[0] = default_camera(scene.world_bounds());
+        std::copy(m_scene.lights.begin(), m_scene.lights.end(), scene.lights.begin());
+        u.cameras = true;
+        u.lights = !m_scene.lights.empty();
+        scene.time = time;
+        m_scene = Scene{};
+        std::swap(log, m_warnings);
+        log.flush_to(scene);
+        return u;
+    }
+
 private:
+    /// repose(): each deforming mesh posed from its rest geometry, in parallel; the vertices are
+    /// written into the Scene's arrays in place.
+    void repose_meshes(Scene& scene, SceneUpdate& u) {
+        for (size_t i = 0; i < m_rest.size(); ++i)
+            if (!m_rest[i].positions.empty()) u.meshes.push_back(uint32_t(i));
+        std::vector<WarningLog> logs(u.meshes.size());
+        tbb::parallel_for(size_t(0), u.meshes.size(), [&](size_t d) {
+            Mesh& rest = m_rest[u.meshes[d]];
+            Mesh posed;
+            posed.positions = rest.positions;
+            posed.normals = rest.normals;
+            posed.tangents = rest.tangents;
+            posed.indices = std::move(rest.indices);  // borrowed (smooth normals, zero-area count)
+            finish_geometry(m_requests[u.meshes[d]], posed, logs[d], false);
+            rest.indices = std::move(posed.indices);
+            Mesh& out = scene.meshes[u.meshes[d]];
+            std::copy(posed.positions.begin(), posed.positions.end(), out.positions.begin());
+            out.normals = std::move(posed.normals);
+            out.tangents = std::move(posed.tangents);
+        });
+        for (const WarningLog& l : logs) m_warnings.append(l);
+    }
+
     template <typename... Args>
     [[noreturn]] void fail(const std::string& pointer, fmt::format_string<Args...> f, Args&&... args) const {
         throw Error(file_loc(m_path, pointer), fmt::format(f, std::forward<Args>(args)...));
@@ -848,6 +921,7 @@ private:
             inst.world_from_object = placed;
             inst.node_name = label;
             inst.node = node;
+            inst.moving = !skinned && m_pose.moving[size_t(node)];
             m_scene.instances.push_back(std::move(inst));
         }
     }
@@ -1212,16 +1286,12 @@ private:
         // request order, so the log is the same for any thread count.
         std::vector<Mesh> built(unique.size());
         std::vector<WarningLog> logs(unique.size());
+        m_rest.assign(n, Mesh{});
         tbb::parallel_for(size_t(0), unique.size(), [&](size_t u) {
             const MeshKey& k = m_requests[unique[u]];
-            const std::string ptr = fmt::format("/meshes/{}/primitives/{}", k.mesh, k.primitive);
-            built[u] = build_geometry(primitive(k), ptr, logs[u]);
-            if (k.node >= 0) {
-                deform_mesh(built[u], m_model, m_path, k.node, k.primitive, m_pose);
-                if (!primitive(k).attributes.count("NORMAL")) built[u].normals = smooth_normals(built[u]);
-            }
-            report_mesh_numbers(sanitize_mesh_numbers(built[u]), ptr, logs[u]);
-            if (k.mirrored) mirror(built[u]);
+            built[u] = build_geometry(primitive(k), mesh_pointer(k), logs[u]);
+            if (k.node >= 0 && deforming(m_model, k.node, m_pose)) m_rest[unique[u]] = built[u];  // for repose()
+            finish_geometry(k, built[u], logs[u]);
         });
 
         m_scene.meshes.reserve(n);
@@ -1240,6 +1310,7 @@ private:
             if (k.mirrored) mesh.name += " (mirrored)";
             const int material = gm.primitives[size_t(k.primitive)].material;
             mesh.material = material >= 0 ? uint32_t(material) : default_material();
+            mesh.deforming = !m_rest[i].positions.empty();
             m_scene.meshes.push_back(std::move(mesh));
         }
         if (m_scene.materials.empty()) default_material();
@@ -1249,12 +1320,30 @@ private:
         return m_model.meshes[size_t(k.mesh)].primitives[size_t(k.primitive)];
     }
 
+    static std::string mesh_pointer(const MeshKey& k) {
+        return fmt::format("/meshes/{}/primitives/{}", k.mesh, k.primitive);
+    }
+
+    /// A primitive's decoded geometry made what the Scene holds: deformed to the pose (its node's
+    /// skin and morph weights; normals computed when the file has none), its numbers sanitised, its
+    /// winding mirrored for a mirroring transform.
+    /// `winding` false: the indices are left as they are (repose() borrows the rest pose's).
+    void finish_geometry(const MeshKey& k, Mesh& mesh, WarningLog& log, bool winding = true) const {
+        if (k.node >= 0) {
+            deform_mesh(mesh, m_model, m_path, k.node, k.primitive, m_pose);
+            if (!primitive(k).attributes.count("NORMAL")) mesh.normals = smooth_normals(mesh);
+        }
+        report_mesh_numbers(sanitize_mesh_numbers(mesh), mesh_pointer(k), log);
+        if (k.mirrored) mirror(mesh, winding);
+    }
+
     /// The copy of a mesh for transforms with a negative determinant: glTF says such a transform
     /// turns the winding clockwise, so swapping two indices restores counter-clockwise fronts.
     /// Tangent w flips too, so cross(N, T) * w computed in world space stays the transformed
     /// bitangent.
-    static void mirror(Mesh& mesh) {
-        for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+    static void mirror(Mesh& mesh, bool winding = true) {
+        if (winding)
+            for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
         for (Vec4f& t : mesh.tangents) t.w = -t.w;
     }
 
@@ -1332,7 +1421,7 @@ private:
     }
 
     const std::string m_path;
-    const ImportOptions m_options;
+    ImportOptions m_options;            ///< its time changes with repose()
     std::string m_base_dir;
     UriPolicy m_uri_policy;
     tinygltf::Model m_model;
@@ -1344,10 +1433,48 @@ private:
     std::map<std::pair<int, bool>, int32_t> m_texture_map;  ///< (glTF texture, sRGB) -> Scene texture
     std::map<MeshKey, uint32_t> m_mesh_map;                 ///< -> Scene mesh
     std::vector<MeshKey> m_requests;                        ///< Scene mesh -> what it is built from
+    std::vector<Mesh> m_rest;       ///< per Scene mesh: a deforming one's geometry before the pose (else empty)
     int m_default_material = -1;
 };
 
 }  // namespace
+
+namespace {
+
+class GltfAnimator final : public SceneAnimator {
+public:
+    GltfAnimator(std::string path, ImportOptions options, std::unique_ptr<GltfImporter> importer)
+        : m_path(std::move(path)), m_options(std::move(options)), m_importer(std::move(importer)) {}
+
+    SceneUpdate pose(Scene& scene, double time) override {
+        if (std::optional<SceneUpdate> u = m_importer->repose(scene, time)) return *u;
+        log_debug("{}: the node graph changes its structure at {} s: loaded again", m_path, time);
+        ImportOptions at = m_options;
+        at.time = time;
+        AnimatedScene fresh = load_animated_scene(m_path, at);
+        scene = std::move(fresh.scene);
+        m_importer = std::move(dynamic_cast<GltfAnimator&>(*fresh.animator).m_importer);
+        SceneUpdate u;
+        u.reloaded = true;
+        return u;
+    }
+
+private:
+    std::string m_path;
+    ImportOptions m_options;
+    std::unique_ptr<GltfImporter> m_importer;
+};
+
+}  // namespace
+
+AnimatedScene import_gltf_animated(const std::string& path, const ImportOptions& options) {
+    const FileBytes bytes = read_file(path, options.max_memory);
+    auto importer = std::make_unique<GltfImporter>(path, options);
+    AnimatedScene a;
+    a.scene = importer->run(bytes.bytes());
+    a.animator = std::make_unique<GltfAnimator>(path, options, std::move(importer));
+    return a;
+}
 
 Scene import_gltf(const std::string& path, const ImportOptions& options) {
     const FileBytes bytes = read_file(path, options.max_memory);

@@ -39,16 +39,20 @@ void check_animation_time(double time, const std::string& what) {
         throw Error(fmt::format("{} {}: expected a finite number of seconds, 0 or more", what, time));
 }
 
-Scene load_scene(const std::string& path, const ImportOptions& options) {
+namespace {
+
+/// The file's extension, lower case; throws for one no importer reads.
+std::string scene_extension(const std::string& path) {
     std::string ext = std::filesystem::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    Scene scene;
-    if (ext == ".gltf" || ext == ".glb") scene = import_gltf(path, options);
-    else if (ext == ".json") scene = import_scene_file(path, options);
-    else
-        throw Error(file_loc(path),
+    if (ext == ".gltf" || ext == ".glb" || ext == ".json") return ext;
+    throw Error(file_loc(path),
                 ext.empty() ? std::string("file has no extension: cannot tell its format (supported: .gltf, .glb, .json)")
                             : "unsupported scene file extension '" + ext + "' (supported: .gltf, .glb, .json)");
+}
+
+/// What load_scene does after the importer: the environment.
+void finish_scene(Scene& scene, const std::string& path, const std::string& ext, const ImportOptions& options) {
     // A glTF file with neither lights nor an environment is lit by the bundled studio map, as
     // glTF viewers do (docs/environment.md); its lights replace the default light.
     const bool unlit = std::all_of(scene.lights.begin(), scene.lights.end(), [](const Light& l) { return l.is_default; });
@@ -60,10 +64,49 @@ Scene load_scene(const std::string& path, const ImportOptions& options) {
                  "(--no-environment: the default light instead)",
                  path, with_studio.environment);
         setup_environment(scene, with_studio);
-        return scene;
+        return;
     }
     setup_environment(scene, options);
+}
+
+/// A scene file posed by loading it again at each time.
+class ReloadAnimator final : public SceneAnimator {
+public:
+    ReloadAnimator(std::string path, ImportOptions options) : m_path(std::move(path)), m_options(std::move(options)) {}
+    SceneUpdate pose(Scene& scene, double time) override {
+        ImportOptions at = m_options;
+        at.time = time;
+        scene = load_scene(m_path, at);
+        SceneUpdate u;
+        u.reloaded = true;
+        return u;
+    }
+
+private:
+    std::string m_path;
+    ImportOptions m_options;
+};
+
+}  // namespace
+
+Scene load_scene(const std::string& path, const ImportOptions& options) {
+    const std::string ext = scene_extension(path);
+    Scene scene = ext == ".json" ? import_scene_file(path, options) : import_gltf(path, options);
+    finish_scene(scene, path, ext, options);
     return scene;
+}
+
+AnimatedScene load_animated_scene(const std::string& path, const ImportOptions& options) {
+    const std::string ext = scene_extension(path);
+    AnimatedScene a;
+    if (ext == ".json") {
+        a.scene = import_scene_file(path, options);
+        a.animator = std::make_unique<ReloadAnimator>(path, options);
+    } else {
+        a = import_gltf_animated(path, options);
+    }
+    finish_scene(a.scene, path, ext, options);
+    return a;
 }
 
 }  // namespace whitted

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -12,6 +13,7 @@
 
 #include "scene/environment.h"
 #include "scene/scene.h"
+#include "scene/scene_update.h"
 
 namespace whitted {
 
@@ -60,11 +62,35 @@ std::vector<std::pair<std::string, std::string>> describe_import_options(const I
 /// import_scene_file in src/importers/scene_file.h).
 Scene load_scene(const std::string& path, const ImportOptions& options = {});
 
+/// A scene loaded once and posed again at other moments in place (the frames of a sequence): only
+/// what an animation moves is rewritten (scene/scene_update.h).
+class SceneAnimator {
+public:
+    virtual ~SceneAnimator() = default;
+    /// Poses `scene` (the one load_animated_scene returned, as the last call left it) at `time`
+    /// seconds: afterwards it is what load_scene at that time returns, and the result says what
+    /// changed. A glTF file is posed from the model kept in memory; a scene file, and a glTF file
+    /// whose node graph changes its structure (a transform turns mirroring), are loaded again
+    /// (SceneUpdate::reloaded). Throws whitted::Error as load_scene does.
+    virtual SceneUpdate pose(Scene& scene, double time) = 0;
+};
+
+struct AnimatedScene {
+    Scene scene;
+    std::unique_ptr<SceneAnimator> animator;
+};
+
+/// load_scene, keeping what it needs to pose the scene again at other times.
+AnimatedScene load_animated_scene(const std::string& path, const ImportOptions& options = {});
+
 /// glTF 2.0 (.gltf with external or data-URI resources, .glb).
 Scene import_gltf(const std::string& path, const ImportOptions& options = {});
 
 /// glTF 2.0 from bytes in memory (JSON, or GLB when `path` ends in .glb or the bytes start with
 /// the GLB magic). `path` names the source in errors; its folder anchors relative URIs.
 Scene import_gltf_memory(std::span<const uint8_t> bytes, const std::string& path, const ImportOptions& options = {});
+
+/// import_gltf keeping the parsed file to pose it again (the environment is load_scene's part).
+AnimatedScene import_gltf_animated(const std::string& path, const ImportOptions& options = {});
 
 }  // namespace whitted

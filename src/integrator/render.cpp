@@ -86,6 +86,23 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
 
 Renderer::~Renderer() = default;
 
+Renderer::Update Renderer::update(const SceneUpdate& update) {
+    if (update.reloaded) throw Error("Renderer::update: the scene was loaded again: a new Renderer is needed");
+    const auto start = Clock::now();
+    Update result;
+    const bool same_flags = m_view.update();
+    if (update.geometry() || !same_flags) {
+        const ScopedFlushDenormals ftz;  // as the build in the constructor
+        result.refit = same_flags && m_accel->update(update);
+        if (!result.refit)
+            m_accel = create_accelerator(m_settings.accel, m_scene, m_view,
+                                         AccelConfig{m_settings.robust, m_settings.threads});
+    }
+    result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    m_build_seconds = result.seconds;
+    return result;
+}
+
 Film Renderer::render(RenderStats* stats) const { return render(m_settings.aa, stats); }
 
 Film Renderer::render(const AaSettings& aa, RenderStats* stats) const {

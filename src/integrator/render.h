@@ -60,6 +60,18 @@ public:
     Renderer(const Scene& scene, const RenderSettings& settings);
     ~Renderer();
 
+    /// What update() did.
+    struct Update {
+        bool refit = false;     ///< the accelerator was updated in place (else built anew, or untouched)
+        double seconds = 0.0;   ///< the view and the accelerator brought up to date
+    };
+    /// Brings the renderer up to date after its scene changed in place as `update` says (the next
+    /// frame of an animation; scene/scene_update.h): the view derived again, the accelerator refit
+    /// (Accelerator::update) or, where the backend cannot, built anew. Renders are then those of a
+    /// new Renderer over the changed scene. A reloaded scene needs a new Renderer (throws). The
+    /// update's time becomes the next renders' build time (RenderStats::build_seconds).
+    Update update(const SceneUpdate& update);
+
     /// Renders the (cropped) image with the settings' anti-aliasing: render_tiles over every tile
     /// in row-major order, pasted into one film. Safe to call repeatedly.
     Film render(RenderStats* stats = nullptr) const;

@@ -67,13 +67,26 @@ constexpr float kNoFootprint[2] = {-kInfinity, -kInfinity};
 
 }  // namespace
 
-SceneView::SceneView(const Scene& scene, const MappingOptions& mapping)
-    : m_scene(scene), m_mapping(mapping), m_analysis(analyze_scene(scene, mapping)) {
-    // Only the prefiltered levels the materials' glossy term reads (most of the map's build time).
-    if (scene.environment)
+SceneView::SceneView(const Scene& scene, const MappingOptions& mapping) : m_scene(scene), m_mapping(mapping) {
+    derive();
+}
+
+bool SceneView::update() {
+    const std::vector<uint32_t> flags = m_mesh_flags;
+    derive();
+    return flags == m_mesh_flags;
+}
+
+void SceneView::derive() {
+    const Scene& scene = m_scene;
+    const uint32_t levels = m_environment ? m_analysis.prefilter_levels : 0;
+    m_analysis = analyze_scene(scene, m_mapping);
+    // Only the prefiltered levels the materials' glossy term reads (most of the map's build time);
+    // built again only when animated materials read other levels.
+    if (scene.environment && (!m_environment || levels != m_analysis.prefilter_levels))
         m_environment = std::make_shared<const EnvironmentMap>(*scene.environment, 0, EnvironmentMap::Use::Rendering,
                                                                m_analysis.prefilter_levels);
-    m_directional_samples.resize(scene.lights.size());
+    m_directional_samples.assign(scene.lights.size(), LightSample{});
     for (size_t i = 0; i < scene.lights.size(); ++i)
         if (scene.lights[i].type == LightType::Directional)
             m_directional_samples[i] = whitted::sample_light(scene.lights[i], Vec3f(0.f));

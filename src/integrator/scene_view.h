@@ -53,6 +53,12 @@ class SceneView final : public SurfaceFilter {
 public:
     SceneView(const Scene& scene, const MappingOptions& mapping);
 
+    /// Derives everything again from the scene after it changed in place (scene_update.h), the
+    /// environment map only when the materials now read other prefiltered levels. Returns false
+    /// when some geometry's traversal flags (mesh_flags) changed: an accelerator built with the
+    /// old ones must be built anew.
+    bool update();
+
     /// Surface data at a hit of unit-direction `ray`; `cone` is the ray's footprint, which
     /// selects texture MIP levels (the default point cone samples the finest level).
     /// kAttributes = false skips what only textures and vertex colors need (UVs, COLOR_0, the
@@ -91,6 +97,8 @@ public:
     uint32_t mesh_flags(uint32_t geom) const override { return m_mesh_flags[geom]; }
 
 private:
+    /// Everything the view holds, from the scene (the environment map when missing or stale).
+    void derive();
     /// Coverage alpha at a hit (base color alpha x texture x vertex alpha), UV0/UV1 interpolated.
     float alpha_at(const Material& m, const Hit& hit) const;
     Vec3f world_geometric_normal(const Hit& hit) const;

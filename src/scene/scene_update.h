@@ -20,10 +20,12 @@ struct SceneUpdate {
     bool cameras = false;             ///< Scene::cameras rewritten (same count)
     bool lights = false;              ///< Scene::lights rewritten (same count)
     bool materials = false;           ///< material factors rewritten (same count, same textures)
+    bool reloaded = false;            ///< the Scene was replaced as a whole (loaded again): everything
+                                      ///< built from it must be built anew; the fields above are unset
 
     /// True when the geometry moved: the accelerator must be brought up to date.
     bool geometry() const { return !meshes.empty() || !instances.empty(); }
-    bool empty() const { return !geometry() && !cameras && !lights && !materials; }
+    bool empty() const { return !geometry() && !cameras && !lights && !materials && !reloaded; }
 };
 
 }  // namespace whitted

@@ -305,7 +305,7 @@ public:
     using Accelerator::intersect;
 
     EmbreeAccelerator(const Scene& scene, const SurfaceFilter& filter, const EmbreeConfig& config)
-        : m_filter(filter), m_packet_width(config.packet_width), m_compact(config.compact) {
+        : m_scene(scene), m_filter(filter), m_packet_width(config.packet_width), m_compact(config.compact) {
         auto start = std::chrono::steady_clock::now();
         std::string device_config = config.threads > 0 ? "threads=" + std::to_string(config.threads) : "";
         m_device = rtcNewDevice(device_config.c_str());
@@ -365,6 +365,9 @@ public:
             // accelerator (accelerator.h).
             rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.indices.data(), 0,
                                        3 * sizeof(uint32_t), mesh.triangle_count());
+            // A deforming mesh's BVH is refit when its vertices move (update()); its own scene,
+            // never flattened (common/flatten.h).
+            if (mesh.deforming) rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_REFIT);
             const uint32_t needs = filter.mesh_flags(uint32_t(m));
             if (needs & SurfaceFilter::kNeedsAccept) rtcSetGeometryIntersectFilterFunction(g, &intersect_filter);
             // Shadow rays read kNeedsTransmittance only (accelerator.h): an opaque single-sided
@@ -398,10 +401,7 @@ public:
             if (!child) continue;  // empty or flattened
             RTCGeometry g = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_INSTANCE);
             rtcSetGeometryInstancedScene(g, child);
-            float xfm[12];
-            for (int r = 0; r < 3; ++r)
-                for (int c = 0; c < 4; ++c) xfm[r * 4 + c] = float(inst.world_from_object(r, c));
-            rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, xfm);
+            set_transform(g, inst.world_from_object);
             rtcCommitGeometry(g);
             rtcAttachGeometryByID(m_top, g, unsigned(i));
             rtcReleaseGeometry(g);
@@ -541,6 +541,51 @@ private:
         }
     }
 
+    /// Deformed meshes: their shared vertex buffers (rewritten in place) refit; moved instances and
+    /// those of the deformed meshes: their transforms set again; then the top level is committed.
+    /// False (rebuild) for anything not built to change: a flattened or empty mesh, an instance
+    /// without its own scene, a vertex array that was reallocated.
+    bool update(const SceneUpdate& u) override {
+        for (uint32_t m : u.meshes)
+            if (m >= m_mesh_scenes.size() || !m_mesh_scenes[m] || !m_scene.meshes[m].deforming ||
+                rtcGetGeometryBufferData(rtcGetGeometry(m_mesh_scenes[m], 0), RTC_BUFFER_TYPE_VERTEX, 0) !=
+                    m_scene.meshes[m].positions.data())
+                return false;
+        for (uint32_t i : u.instances)
+            if (i >= m_mesh_of_instance.size() || m_mesh_of_instance[i] >= m_mesh_scenes.size() ||
+                !m_mesh_scenes[m_mesh_of_instance[i]])
+                return false;
+        for (uint32_t m : u.meshes) {
+            RTCGeometry g = rtcGetGeometry(m_mesh_scenes[m], 0);
+            rtcUpdateGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0);
+            rtcCommitGeometry(g);
+            rtcCommitScene(m_mesh_scenes[m]);
+        }
+        // Every instance of a changed mesh is committed again (its bounds moved), moved ones with
+        // their new transform.
+        std::vector<uint8_t> changed(m_mesh_scenes.size(), 0);
+        for (uint32_t m : u.meshes) changed[m] = 1;
+        std::vector<uint8_t> moved(m_mesh_of_instance.size(), 0);
+        for (uint32_t i : u.instances) moved[i] = 1;
+        for (size_t i = 0; i < m_mesh_of_instance.size(); ++i) {
+            const uint32_t m = m_mesh_of_instance[i];
+            if (!moved[i] && !(m < changed.size() && changed[m] && m_mesh_scenes[m])) continue;
+            RTCGeometry g = rtcGetGeometry(m_top, unsigned(i));
+            if (moved[i]) set_transform(g, m_scene.instances[i].world_from_object);
+            rtcCommitGeometry(g);
+        }
+        rtcCommitScene(m_top);
+        throw_pending("updating the scene");
+        return true;
+    }
+
+    static void set_transform(RTCGeometry g, const Mat4d& world_from_object) {
+        float xfm[12];
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 4; ++c) xfm[r * 4 + c] = float(world_from_object(r, c));
+        rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, xfm);
+    }
+
     static void on_error(void* user, RTCError code, const char* message) {
         auto* self = static_cast<EmbreeAccelerator*>(user);
         std::lock_guard lock(self->m_error_mutex);
@@ -556,6 +601,7 @@ private:
         if (!m_error.empty()) throw Error(fmt::format("{} while {}", m_error, what));
     }
 
+    const Scene& m_scene;  ///< outlives the accelerator (accelerator.h): update() reads its changes
     const SurfaceFilter& m_filter;
     RTCDevice m_device = nullptr;
     RTCScene m_top = nullptr;
