@@ -767,7 +767,7 @@ std::unique_ptr<Accelerator> wide_meshes_under(const Scene& s, const SurfaceFilt
                                                const std::function<Top(const std::vector<Bounds3f>&)>& top) {
     const BvhBuildConfig build = wide_bvh_build_defaults();
     return std::make_unique<TwoLevelAccelerator<float, WideTriangleBvh<8>, NoSpheres, Top>>(
-        "bvh", s, filter, [&](const Mesh& m) { return WideTriangleBvh<8>(TrianglePrims<float>(m), build, {}); },
+        "bvh", s, filter, [build](const Mesh& m) { return WideTriangleBvh<8>(TrianglePrims<float>(m), build, {}); },
         [](SpherePrims<float>&&) {
             ADD_FAILURE() << "no spheres in these scenes";
             return NoSpheres{};

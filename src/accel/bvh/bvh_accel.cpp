@@ -35,8 +35,39 @@ public:
         m_sah = sah_cost(built, config);
         // Primitives in leaf order: a leaf reads a contiguous run.
         m_prims.reorder(m_ids);
-        if (!built.empty()) m_bounds = built[0].box;
-        m_extent = abs_extent(m_bounds.lo, m_bounds.hi);
+        fit(built);
+    }
+
+    /// Refits to the mesh's new vertex positions (same triangles, same count): the topology and
+    /// the leaf order stay, the node volumes are fitted again by fit() from boxes recomputed
+    /// bottom-up, so each volume encloses its subtree exactly as a build's would. The SAH figure
+    /// stays the build's.
+    void refit(const Mesh& mesh)
+        requires std::is_same_v<P, TrianglePrims<T>>
+    {
+        m_prims = P(mesh);
+        m_prims.reorder(m_ids);
+        // The builder's view of the tree, children after their parent: a leaf's box is the union
+        // of its primitives' boxes, an inner node's the union of its children's, which is what
+        // build_bvh computes (min and max are exact: the grouping does not change the box).
+        std::vector<BuildNode<T>> built(m_nodes.size());
+        for (size_t i = built.size(); i-- > 0;) {
+            BuildNode<T>& b = built[i];
+            b.index = m_nodes[i].index;
+            b.count = m_nodes[i].count;
+            if (b.count > 0) {
+                b.begin = b.index;
+                b.end = b.index + b.count;
+                for (uint32_t k = b.begin; k < b.end; ++k) b.box.extend(m_prims.bounds(k));
+            } else {
+                const BuildNode<T>& left = built[b.index];
+                const BuildNode<T>& right = built[b.index + 1];
+                b.begin = left.begin;
+                b.end = right.end;
+                b.box = left.box;
+                b.box.extend(right.box);
+            }
+        }
         fit(built);
     }
 
@@ -60,8 +91,11 @@ public:
     }
 
 private:
-    /// Converts the builder's boxes into the node volume V.
+    /// Converts the builder's boxes into the node volume V and takes the root's box (build and
+    /// refit alike; m_prims in leaf order).
     void fit(const std::vector<BuildNode<T>>& built) {
+        if (!built.empty()) m_bounds = built[0].box;
+        m_extent = abs_extent(m_bounds.lo, m_bounds.hi);
         m_nodes.resize(built.size());
         if constexpr (std::is_same_v<V, AabbVolume<T>>) {
             for (size_t i = 0; i < built.size(); ++i) m_nodes[i] = {{built[i].box.lo, built[i].box.hi}, built[i].index, built[i].count};
@@ -142,8 +176,9 @@ std::unique_ptr<Accelerator> make_bvh(const char* name, const Scene& scene, cons
     // Spheres: small leaves (a sphere test costs about as much as a node test).
     BvhBuildConfig sphere_build = build;
     sphere_build.max_leaf_size = std::min(build.max_leaf_size, 2);
+    // The mesh builder outlives this call (update() may build a mesh again): settings by value.
     return std::make_unique<TwoLevelAccelerator<T, Blas, SphereBlas>>(
-        name, scene, filter, [&](const Mesh& m) { return Blas(TrianglePrims<T>(m), build); },
+        name, scene, filter, [build](const Mesh& m) { return Blas(TrianglePrims<T>(m), build); },
         [&](SpherePrims<T>&& s) { return SphereBlas(std::move(s), sphere_build); }, true, flatten);
 }
 
@@ -157,10 +192,11 @@ std::unique_ptr<Accelerator> make_wide_bvh(const Scene& scene, const SurfaceFilt
     using Top = WideInstanceTree<N>;
     BvhBuildConfig sphere_build = build;
     sphere_build.max_leaf_size = std::min(build.max_leaf_size, 2);
+    // The mesh and top-level builders outlive this call (update()): settings by value.
     return std::make_unique<TwoLevelAccelerator<float, Blas, SphereBlas, Top>>(
-        "bvh", scene, filter, [&](const Mesh& m) { return Blas(TrianglePrims<float>(m), build, options); },
+        "bvh", scene, filter, [build, options](const Mesh& m) { return Blas(TrianglePrims<float>(m), build, options); },
         [&](SpherePrims<float>&& s) { return SphereBlas(std::move(s), sphere_build); },
-        [&](const std::vector<Bounds3f>& boxes) { return Top(boxes, options); }, flatten);
+        [options](const std::vector<Bounds3f>& boxes) { return Top(boxes, options); }, flatten);
 }
 
 template <typename T>

@@ -13,6 +13,13 @@
 // the brute-force oracle hit for hit; double-precision structures never flatten (world-space
 // vertices would be rounded to float).
 //
+// update() (accelerator.h) refits the BLAS of each deformed mesh, or builds it again with the
+// kept builder where the BLAS type cannot refit, recomputes the moved instances' transforms and
+// builds the top level again over the new world boxes; the spheres and the flat BLAS (static by
+// flatten.h) stay. Refit keeps a tree's shape, so its hits are a new build's as long as its
+// volumes enclose their subtrees and the leaves see the same vertices: the tie rule of queries.h
+// makes the closest hit independent of the shape.
+//
 // A BLAS type provides
 //   template <class Query> bool traverse(const Vec3<T>& org, const Vec3<T>& dir, T tnear, Query& q) const;
 //     reports every candidate hit in (tnear, q.tmax] to q.report(...) and returns true as soon
@@ -22,7 +29,11 @@
 //   template <class Query> bool traverse_prepared(const PreparedRay& r, Query& q) const;
 //     the same from the per-ray constants the top level hands to visit() (PreparedRay is the
 //     top level's type, e.g. WideRay<N>; constructible from (org, dir, tnear)): identity
-//     instances reuse the world ray's, transformed ones build their own.
+//     instances reuse the world ray's, transformed ones build their own;
+//   void refit(const Mesh& mesh);
+//     the mesh's vertices moved (same triangles): brings the structure up to date in place,
+//     answering every query as a build over the new vertices would (update(); without it the
+//     mesh is built again).
 // A top level type provides
 //   template <class Query, class Visit> bool traverse(org, dir, tnear, Query& q, Visit&& visit) const;
 //     calls visit(i, prepared) for the instances i (numbered as the boxes it was built from)
@@ -151,31 +162,33 @@ public:
     /// Builds the BLASes in parallel over meshes (each build is deterministic), then the top
     /// level over the instances' world boxes and the sphere structure (when the scene has
     /// spheres). `flatten`: single-use meshes share one world-space BLAS (see the top).
+    /// `build_blas` and `build_top` are kept for update(): they must not refer to the caller's
+    /// locals.
     TwoLevelAccelerator(std::string name, const Scene& scene, const SurfaceFilter& filter, const BlasBuilder& build_blas,
                         const SphereBuilder& build_spheres, const TopBuilder& build_top, bool flatten = true)
-        : m_name(std::move(name)), m_scene(scene), m_filter(filter) {
+        : m_name(std::move(name)), m_scene(scene), m_filter(filter), m_build_blas(build_blas), m_build_top(build_top) {
         const auto start = std::chrono::steady_clock::now();
         // Spheres: world space, each with its own geometry id and filter flags.
         SpherePrims<T> spheres(scene, filter);
         if (spheres.size() > 0) m_spheres = std::make_unique<SphereBlas>(build_spheres(std::move(spheres)));
         // Which instances are flattened (none unless at least two would share the flat BLAS).
-        const std::vector<uint8_t> flat = flattened_instances(scene, flatten && std::is_same_v<T, float>);
-        std::vector<uint8_t> mesh_flat(scene.meshes.size(), 0);
-        for (size_t i = 0; i < flat.size(); ++i)
-            if (flat[i]) mesh_flat[scene.instances[i].mesh] = 1;
+        m_flat = flattened_instances(scene, flatten && std::is_same_v<T, float>);
+        m_mesh_flat.assign(scene.meshes.size(), 0);
+        for (size_t i = 0; i < m_flat.size(); ++i)
+            if (m_flat[i]) m_mesh_flat[scene.instances[i].mesh] = 1;
         // Bottom level: one structure per instanced mesh that has triangles, and the flat one,
         // meshes in parallel on the worker pool (whose fork and join ThreadSanitizer sees, and
         // whose workers build in the same floating-point mode as the caller).
         m_blas.resize(scene.meshes.size());
         WorkerPool(0).for_each(scene.meshes.size(), [&](size_t m, int) {
-            if (scene.meshes[m].triangle_count() > 0 && !mesh_flat[m])
+            if (scene.meshes[m].triangle_count() > 0 && !m_mesh_flat[m])
                 m_blas[m] = std::make_unique<Blas>(build_blas(scene.meshes[m]));
         });
-        if (std::find(flat.begin(), flat.end(), 1) != flat.end()) {
+        if (std::find(m_flat.begin(), m_flat.end(), 1) != m_flat.end()) {
             // World-space vertices (transformed in double, rounded once), each triangle's origin kept.
             Mesh merged;
-            for (size_t i = 0; i < flat.size(); ++i) {
-                if (!flat[i]) continue;
+            for (size_t i = 0; i < m_flat.size(); ++i) {
+                if (!m_flat[i]) continue;
                 const Instance& inst = scene.instances[i];
                 const Mesh& mesh = scene.meshes[inst.mesh];
                 const auto base = uint32_t(merged.positions.size());
@@ -188,45 +201,55 @@ public:
         }
         // Instances with their inverse transforms and world boxes; the flat BLAS is one more
         // entry with the identity transform.
-        std::vector<Bounds3<T>> boxes;
-        if (m_flat_blas) {
-            m_instances.push_back(InstanceData{Affine<T>(), kFlatMesh, kInvalidId, 0});
-            boxes.push_back(m_flat_blas->bounds());
-        }
-        for (size_t i = 0; i < scene.instances.size(); ++i) {
-            const Instance& inst = scene.instances[i];
-            if (!m_blas[inst.mesh]) continue;
-            InstanceData d{Affine<T>(inst.world_from_object.inverse_affine()), inst.mesh, uint32_t(i),
-                           filter.mesh_flags(inst.mesh)};
-            d.object_from_world.identity = inst.world_from_object == Mat4d::identity();
-            m_instances.push_back(d);
-            boxes.push_back(world_box(m_blas[inst.mesh]->bounds(), inst.world_from_object));
-        }
-        m_top = build_top(boxes);
+        if (m_flat_blas) m_instances.push_back(InstanceData{Affine<T>(), kFlatMesh, kInvalidId, 0});
+        for (size_t i = 0; i < scene.instances.size(); ++i)
+            if (m_blas[scene.instances[i].mesh]) m_instances.push_back(instance_data(uint32_t(i)));
+        m_top = build_top(world_boxes());
         m_stats.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        // Size figures: the BLASes, the top level and the per-instance data.
-        double sah_weighted = 0.0;
-        size_t tris = 0;
-        auto add = [&](const Blas& blas, size_t triangles) {
-            const BlasStats s = blas.stats();
-            m_stats.bytes += s.bytes;
-            m_stats.nodes += s.nodes;
-            m_stats.references += s.references;
-            sah_weighted += s.sah_cost * double(triangles);
-            tris += triangles;
-        };
-        for (size_t m = 0; m < m_blas.size(); ++m)
-            if (m_blas[m]) add(*m_blas[m], scene.meshes[m].triangle_count());
-        if (m_flat_blas) add(*m_flat_blas, m_flat_prims.size());
-        m_stats.sah_cost = tris ? sah_weighted / double(tris) : 0.0;
-        if (m_spheres) {
-            const BlasStats s = m_spheres->stats();
-            m_stats.bytes += s.bytes;
-            m_stats.nodes += s.nodes;
-            m_stats.references += s.references;
+        size_stats();
+    }
+
+    /// Refits the BLAS of each mesh in `update.meshes` to the scene's new vertices (builds it
+    /// again where the BLAS type has no refit()), takes the new transforms of the instances in
+    /// `update.instances`, and builds the top level again over the new world boxes; spheres and
+    /// the flat BLAS are left as they are. False, changing nothing, when the update names a mesh
+    /// or instance out of range or in the flat BLAS (flatten.h keeps animated geometry out of it,
+    /// so the caller has changed what it promised not to). AccelStats: build_seconds stays the
+    /// build's; bytes, nodes and references are summed again (a mesh built again may have other
+    /// figures); a refit BLAS keeps its build's SAH cost.
+    bool update(const SceneUpdate& update) override {
+        const Scene& scene = m_scene;
+        // Check everything before changing anything; duplicates and order do not matter.
+        std::vector<uint8_t> deformed(scene.meshes.size(), 0), moved(scene.instances.size(), 0);
+        for (uint32_t m : update.meshes) {
+            if (m >= scene.meshes.size() || m_mesh_flat[m]) return false;
+            deformed[m] = 1;
         }
-        m_stats.bytes += m_top.bytes() + m_instances.size() * sizeof(InstanceData) + m_flat_prims.size() * sizeof(FlatPrim);
-        m_stats.nodes += m_top.nodes();
+        for (uint32_t i : update.instances) {
+            if (i >= scene.instances.size() || m_flat[i]) return false;
+            moved[i] = 1;
+        }
+        if (!update.geometry()) return true;
+        // Bottom level: in parallel over the deformed meshes, on the worker pool as the build
+        // (the same floating-point mode); a mesh without triangles has no BLAS to bring up to date.
+        std::vector<uint32_t> meshes;
+        for (uint32_t m = 0; m < deformed.size(); ++m)
+            if (deformed[m] && m_blas[m]) meshes.push_back(m);
+        WorkerPool(0).for_each(meshes.size(), [&](size_t k, int) {
+            const Mesh& mesh = scene.meshes[meshes[k]];
+            std::unique_ptr<Blas>& blas = m_blas[meshes[k]];
+            if constexpr (kBlasRefits)
+                blas->refit(mesh);
+            else
+                blas = std::make_unique<Blas>(m_build_blas(mesh));
+        });
+        // Top level: the moved instances' inverse transforms, then every world box (a deformed
+        // mesh changes the boxes of all its instances) and a new tree over them.
+        for (InstanceData& d : m_instances)
+            if (d.mesh != kFlatMesh && moved[d.inst]) d = instance_data(d.inst);
+        m_top = m_build_top(world_boxes());
+        size_stats();
+        return true;
     }
 
     Hit intersect(const Ray& ray, RayKind kind) const override {
@@ -274,6 +297,56 @@ private:
             return q.report(t, u, v, f.prim, part);
         }
     };
+
+    /// Whether Blas refits in place (else update() builds a deformed mesh's BLAS again).
+    static constexpr bool kBlasRefits = requires(Blas& b, const Mesh& m) { b.refit(m); };
+
+    /// Instance i as the top level enters it: the inverse transform (identity flagged, so the
+    /// world ray's per-ray constants serve) and the filter needs of its mesh.
+    InstanceData instance_data(uint32_t i) const {
+        const Instance& inst = m_scene.instances[i];
+        InstanceData d{Affine<T>(inst.world_from_object.inverse_affine()), inst.mesh, i,
+                       m_filter.mesh_flags(inst.mesh)};
+        d.object_from_world.identity = inst.world_from_object == Mat4d::identity();
+        return d;
+    }
+
+    /// The world boxes of m_instances, in order: the top level is built over them.
+    std::vector<Bounds3<T>> world_boxes() const {
+        std::vector<Bounds3<T>> boxes;
+        boxes.reserve(m_instances.size());
+        for (const InstanceData& d : m_instances) {
+            if (d.mesh == kFlatMesh)
+                boxes.push_back(m_flat_blas->bounds());
+            else
+                boxes.push_back(world_box(m_blas[d.mesh]->bounds(), m_scene.instances[d.inst].world_from_object));
+        }
+        return boxes;
+    }
+
+    /// The size figures of m_stats (all but build_seconds): the BLASes, the top level and the
+    /// per-instance data.
+    void size_stats() {
+        const double build_seconds = m_stats.build_seconds;
+        m_stats = AccelStats{};
+        m_stats.build_seconds = build_seconds;
+        double sah_weighted = 0.0;
+        size_t tris = 0;
+        auto add = [&](const BlasStats& s, size_t triangles) {
+            m_stats.bytes += s.bytes;
+            m_stats.nodes += s.nodes;
+            m_stats.references += s.references;
+            sah_weighted += s.sah_cost * double(triangles);
+            tris += triangles;
+        };
+        for (size_t m = 0; m < m_blas.size(); ++m)
+            if (m_blas[m]) add(m_blas[m]->stats(), m_scene.meshes[m].triangle_count());
+        if (m_flat_blas) add(m_flat_blas->stats(), m_flat_prims.size());
+        m_stats.sah_cost = tris ? sah_weighted / double(tris) : 0.0;
+        if (m_spheres) add(m_spheres->stats(), 0);  // spheres take no part in the triangles' SAH
+        m_stats.bytes += m_top.bytes() + m_instances.size() * sizeof(InstanceData) + m_flat_prims.size() * sizeof(FlatPrim);
+        m_stats.nodes += m_top.nodes();
+    }
 
     /// Per instance: whether it goes into the flat BLAS (its mesh flattenable_meshes()); all 0
     /// unless at least two qualify (one alone gains nothing from sharing a BLAS).
@@ -346,6 +419,10 @@ private:
     std::string m_name;
     const Scene& m_scene;  ///< outlives the accelerator (accelerator.h): triangles of crossings
     const SurfaceFilter& m_filter;
+    BlasBuilder m_build_blas;                   ///< update(): meshes whose BLAS cannot refit
+    TopBuilder m_build_top;                     ///< update(): the top level over the new boxes
+    std::vector<uint8_t> m_flat;                ///< per instance: in the flat BLAS
+    std::vector<uint8_t> m_mesh_flat;           ///< per mesh: in the flat BLAS
     std::vector<std::unique_ptr<Blas>> m_blas;  ///< per mesh; null for flattened meshes
     std::unique_ptr<Blas> m_flat_blas;         ///< the flattened meshes in world space, or null
     std::vector<FlatPrim> m_flat_prims;        ///< per triangle of m_flat_blas

@@ -126,6 +126,30 @@ public:
         RT_CHECK(m_depth <= kBvhMaxDepth);
     }
 
+    /// Recomputes every child box bottom-up after the items moved, the topology unchanged:
+    /// `leaf_box(index, count)` gives the box of a leaf (as pack_leaf returned it), an inner
+    /// child's box is the union of its node's children. Every box then equals the binary
+    /// build's box over the same items (the union of the items' boxes: min and max are exact,
+    /// so the grouping does not change it).
+    template <class LeafBox>
+    void refit(LeafBox&& leaf_box) {
+        // Children come after their parent in the array: backwards, a node's children are done.
+        for (size_t n = m_nodes.size(); n-- > 0;) {
+            WideNode<N>& node = m_nodes[n];
+            for (int i = 0; i < N; ++i) {
+                if (!((node.used >> i) & 1u)) continue;
+                const Bounds3f b = node.count[i] > 0 ? leaf_box(node.child[i], uint32_t(node.count[i]))
+                                                     : node_bounds(m_nodes[node.child[i]]);
+                for (int k = 0; k < 3; ++k) {
+                    node.bounds[2 * k][i] = b.lo[k];
+                    node.bounds[2 * k + 1][i] = b.hi[k];
+                }
+            }
+        }
+    }
+
+    /// The box around everything in the tree (empty for an empty tree).
+    Bounds3f bounds() const { return m_nodes.empty() ? Bounds3f{} : node_bounds(m_nodes[0]); }
     bool empty() const { return m_nodes.empty(); }
     size_t size() const { return m_nodes.size(); }
     size_t bytes() const { return m_nodes.size() * sizeof(WideNode<N>); }
@@ -223,6 +247,16 @@ public:
     }
 
 private:
+    /// The union of a node's used children's boxes.
+    static Bounds3f node_bounds(const WideNode<N>& node) {
+        Bounds3f b;
+        for (int i = 0; i < N; ++i)
+            if ((node.used >> i) & 1u)
+                b.extend(Bounds3f{Vec3f(node.bounds[0][i], node.bounds[2][i], node.bounds[4][i]),
+                                  Vec3f(node.bounds[1][i], node.bounds[3][i], node.bounds[5][i])});
+        return b;
+    }
+
     /// One node's children or one leaf: what the traversal stack holds.
     struct Ref {
         uint32_t index;   ///< node index, or the leaf's index as pack_leaf returned it
@@ -323,14 +357,38 @@ public:
         const std::vector<BuildNode<float>> built = build_bvh(boxes, config, ids);
         m_sah = sah_cost(built, config);
         if (built.empty()) return;
-        m_bounds = built[0].box;
-        m_extent = abs_extent(m_bounds.lo, m_bounds.hi);
+        set_bounds(built[0].box);
         m_triangles = uint32_t(ids.size());
         m_packets.reserve(ids.size() / 2 + 1);
         m_tree.build(built, [&](uint32_t first, uint32_t count) {
             const uint32_t start = pack_leaf(prims, ids, first, count);
             return std::pair<uint32_t, uint32_t>(start, uint32_t(m_packets.size()) - start);
         });
+    }
+
+    /// Refits to the mesh's new vertex positions (same triangles, same count): every packet's
+    /// vertices rewritten as the build stores them, every box recomputed bottom-up from the
+    /// triangles' boxes (WideTree::refit), so boxes and leaf data are those a build with this
+    /// topology would have. The SAH figure stays the build's.
+    void refit(const Mesh& mesh) {
+        const TrianglePrims<float> prims(mesh);
+        for (TrianglePacket4& p : m_packets) {
+            int32_t last = p.id[0];  // lane 0 always holds a triangle
+            for (int lane = 0; lane < 4; ++lane) {
+                // A padding lane (id -1) repeats the leaf's last triangle, as pack_leaf stores it.
+                const int32_t id = p.id[lane];
+                if (id >= 0) last = id;
+                store_lane(p, lane, prims.triangle(uint32_t(last)));
+            }
+        }
+        m_tree.refit([&](uint32_t first, uint32_t count) {
+            Bounds3f b;
+            for (uint32_t k = first; k < first + count; ++k)
+                for (int lane = 0; lane < 4; ++lane)
+                    if (m_packets[k].id[lane] >= 0) b.extend(prims.bounds(uint32_t(m_packets[k].id[lane])));
+            return b;
+        });
+        set_bounds(m_tree.bounds());
     }
 
     /// Reports every candidate hit in (tnear, q.tmax] to q.report(t, u, v, triangle); true as
@@ -435,15 +493,24 @@ private:
             for (int lane = 0; lane < 4; ++lane) {
                 const uint32_t k = std::min(base + uint32_t(lane), count - 1);
                 const uint32_t id = ids[first + k];
-                const TriangleVerts<float>& tri = prims.triangle(id);
-                const Vec3f* verts[3] = {&tri.p0, &tri.p1, &tri.p2};
-                for (int vtx = 0; vtx < 3; ++vtx)
-                    for (int axis = 0; axis < 3; ++axis) p.v[vtx][axis][lane] = component(*verts[vtx], axis);
+                store_lane(p, lane, prims.triangle(id));
                 p.id[lane] = base + uint32_t(lane) < count ? int32_t(id) : -1;
             }
             m_packets.push_back(p);
         }
         return start;
+    }
+
+    /// Writes a triangle's vertices into one lane of a packet (build and refit).
+    static void store_lane(TrianglePacket4& p, int lane, const TriangleVerts<float>& tri) {
+        const Vec3f* verts[3] = {&tri.p0, &tri.p1, &tri.p2};
+        for (int vtx = 0; vtx < 3; ++vtx)
+            for (int axis = 0; axis < 3; ++axis) p.v[vtx][axis][lane] = component(*verts[vtx], axis);
+    }
+
+    void set_bounds(const Bounds3f& b) {
+        m_bounds = b;
+        m_extent = abs_extent(b.lo, b.hi);
     }
 
     WideTree<N> m_tree;
