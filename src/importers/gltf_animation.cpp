@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "core/error.h"
 #include "importers/gltf_accessor.h"
@@ -483,11 +485,9 @@ void add_targets(const tinygltf::Model& model, const tinygltf::Primitive& p, con
     }
 }
 
-/// Per vertex, the skin matrix: the sum of its joints' matrices times their weights (every
-/// JOINTS_n/WEIGHTS_n set; weights divided by their sum when it is neither 0 nor 1).
-std::vector<Mat4d> skin_matrices(const tinygltf::Model& model, const std::string& path, int node,
-                                 const tinygltf::Primitive& p, size_t vertices, const GltfPose& pose) {
-    const int skin_index = model.nodes[size_t(node)].skin;
+/// The skin's joint matrices global(joint) x inverseBindMatrix at the pose.
+std::vector<Mat4d> joint_matrices(const tinygltf::Model& model, const std::string& path, int skin_index,
+                                  const GltfPose& pose) {
     const tinygltf::Skin& skin = model.skins[size_t(skin_index)];
     const std::string sptr = fmt::format("/skins/{}", skin_index);
     std::vector<Mat4d> joint(skin.joints.size());
@@ -513,77 +513,137 @@ std::vector<Mat4d> skin_matrices(const tinygltf::Model& model, const std::string
             throw Error(file_loc(path, fmt::format("{}/joints/{}", sptr, j)), fmt::format("node {} does not exist", jn));
         joint[j] = pose.world[size_t(jn)] * inverse_bind[j];
     }
-    // Every set's joints and weights, 4 per set.
-    std::vector<std::array<float, 4>> joints_of, weights_of;
-    std::vector<double> sum(vertices, 0.0);
-    std::vector<Mat4d> out(vertices);
-    for (Mat4d& m : out) m.m.fill(0.0);
-    for (int set = 0;; ++set) {
-        const auto ji = p.attributes.find(fmt::format("JOINTS_{}", set));
-        const auto wi = p.attributes.find(fmt::format("WEIGHTS_{}", set));
-        if (ji == p.attributes.end() || wi == p.attributes.end()) break;
-        joints_of.assign(vertices, {0, 0, 0, 0});
-        weights_of.assign(vertices, {0, 0, 0, 0});
-        for_each_element(accessor_data(model, ji->second), [&](size_t i, const float* v) {
-            if (i < vertices) joints_of[i] = {v[0], v[1], v[2], v[3]};
-        });
-        for_each_element(accessor_data(model, wi->second), [&](size_t i, const float* v) {
-            if (i < vertices) weights_of[i] = {v[0], v[1], v[2], v[3]};
-        });
-        for (size_t i = 0; i < vertices; ++i)
-            for (int k = 0; k < 4; ++k) {
-                const double w = weights_of[i][size_t(k)];
-                if (w == 0.0) continue;
-                const float jf = joints_of[i][size_t(k)];
-                if (!(jf >= 0.f && size_t(jf) < joint.size()))
-                    throw Error(file_loc(path, fmt::format("/accessors/{}", ji->second)),
-                                fmt::format("JOINTS_{} of vertex {} is {}, outside skin {}'s {} joints", set, i, jf,
-                                            skin_index, joint.size()));
-                const Mat4d& J = joint[size_t(jf)];
-                for (size_t e = 0; e < 16; ++e) out[i].m[e] += w * J.m[e];
-                sum[i] += w;
-            }
+    return joint;
+}
+
+/// Vertex `i`'s skin matrix (rows 0-2): the sum of its joints' matrices times their weights,
+/// divided by the weights' sum when it is neither 0 nor 1.
+Mat4d blend_joints(const SkinBinding& b, const std::vector<Mat4d>& joint, size_t i) {
+    Mat4d out;
+    out.m.fill(0.0);
+    double sum = 0.0;
+    const size_t n = b.influences;
+    for (size_t k = 0; k < n; ++k) {
+        const double w = b.weights[i * n + k];
+        if (w == 0.0) continue;
+        const Mat4d& J = joint[b.joints[i * n + k]];
+        for (size_t e = 0; e < 12; ++e) out.m[e] += w * J.m[e];
+        sum += w;
     }
-    for (size_t i = 0; i < vertices; ++i)
-        if (sum[i] != 0.0 && sum[i] != 1.0)
-            for (double& e : out[i].m) e /= sum[i];
+    if (sum != 0.0 && sum != 1.0)
+        for (size_t e = 0; e < 12; ++e) out.m[e] /= sum;
     return out;
+}
+
+/// The normal matrix's direction: the cofactors of the 3x3 block (the inverse transpose times the
+/// determinant), signed by the determinant; zero for a singular block. Normalised by the caller.
+Vec3d transform_normal(const Mat4d& m, const Vec3d& n) {
+    const double c00 = m.m[5] * m.m[10] - m.m[6] * m.m[9], c01 = m.m[6] * m.m[8] - m.m[4] * m.m[10],
+                 c02 = m.m[4] * m.m[9] - m.m[5] * m.m[8];
+    const double c10 = m.m[2] * m.m[9] - m.m[1] * m.m[10], c11 = m.m[0] * m.m[10] - m.m[2] * m.m[8],
+                 c12 = m.m[1] * m.m[8] - m.m[0] * m.m[9];
+    const double c20 = m.m[1] * m.m[6] - m.m[2] * m.m[5], c21 = m.m[2] * m.m[4] - m.m[0] * m.m[6],
+                 c22 = m.m[0] * m.m[5] - m.m[1] * m.m[4];
+    const double det = m.m[0] * c00 + m.m[1] * c01 + m.m[2] * c02;
+    const double s = det > 0.0 ? 1.0 : det < 0.0 ? -1.0 : 0.0;
+    return Vec3d(c00 * n.x + c01 * n.y + c02 * n.z, c10 * n.x + c11 * n.y + c12 * n.z,
+                 c20 * n.x + c21 * n.y + c22 * n.z) * s;
 }
 
 }  // namespace
 
+SkinBinding skin_binding(const tinygltf::Model& model, const std::string& path, int node, int primitive,
+                         size_t vertices) {
+    SkinBinding b;
+    const tinygltf::Node& n = model.nodes[size_t(node)];
+    const tinygltf::Primitive& p = model.meshes[size_t(n.mesh)].primitives[size_t(primitive)];
+    if (n.skin < 0 || !p.attributes.count("JOINTS_0") || !p.attributes.count("WEIGHTS_0")) return b;
+    const size_t joint_count = model.skins[size_t(n.skin)].joints.size();
+    b.skinned = true;
+    int sets = 0;
+    while (p.attributes.count(fmt::format("JOINTS_{}", sets)) && p.attributes.count(fmt::format("WEIGHTS_{}", sets)))
+        ++sets;
+    b.influences = size_t(sets) * 4;
+    b.joints.assign(vertices * b.influences, 0);
+    b.weights.assign(vertices * b.influences, 0.f);
+    std::vector<std::array<float, 4>> joints_of, weights_of;
+    for (int set = 0; set < sets; ++set) {
+        const int ja = p.attributes.at(fmt::format("JOINTS_{}", set));
+        const int wa = p.attributes.at(fmt::format("WEIGHTS_{}", set));
+        joints_of.assign(vertices, {0, 0, 0, 0});
+        weights_of.assign(vertices, {0, 0, 0, 0});
+        for_each_element(accessor_data(model, ja), [&](size_t i, const float* v) {
+            if (i < vertices) joints_of[i] = {v[0], v[1], v[2], v[3]};
+        });
+        for_each_element(accessor_data(model, wa), [&](size_t i, const float* v) {
+            if (i < vertices) weights_of[i] = {v[0], v[1], v[2], v[3]};
+        });
+        for (size_t i = 0; i < vertices; ++i)
+            for (size_t k = 0; k < 4; ++k) {
+                const float w = weights_of[i][k];
+                if (w == 0.f) continue;
+                const float jf = joints_of[i][k];
+                if (!(jf >= 0.f && size_t(jf) < joint_count))
+                    throw Error(file_loc(path, fmt::format("/accessors/{}", ja)),
+                                fmt::format("JOINTS_{} of vertex {} is {}, outside skin {}'s {} joints", set, i, jf,
+                                            n.skin, joint_count));
+                b.joints[i * b.influences + size_t(set) * 4 + k] = uint32_t(jf);
+                b.weights[i * b.influences + size_t(set) * 4 + k] = w;
+            }
+    }
+    return b;
+}
+
 void deform_mesh(Mesh& mesh, const tinygltf::Model& model, const std::string& path, int node, int primitive,
-                 const GltfPose& pose) {
+                 const GltfPose& pose, const SkinBinding* binding) {
     const tinygltf::Node& n = model.nodes[size_t(node)];
     const tinygltf::Primitive& p = model.meshes[size_t(n.mesh)].primitives[size_t(primitive)];
     const size_t nv = mesh.positions.size();
-    std::vector<Vec3d> pos(nv), nrm(nv), tan(nv);
-    for (size_t i = 0; i < nv; ++i) pos[i] = Vec3d(mesh.positions[i]);
-    for (size_t i = 0; i < mesh.normals.size() && i < nv; ++i) nrm[i] = Vec3d(mesh.normals[i]);
-    for (size_t i = 0; i < mesh.tangents.size() && i < nv; ++i) tan[i] = Vec3d(mesh.tangents[i].xyz());
-    // Morph targets (glTF 2.0 section 3.7.2.2): base + sum of weight x displacement.
+    // Morph targets (glTF 2.0 section 3.7.2.2): base + sum of weight x displacement, in double.
     const std::vector<float>& w = pose.weights[size_t(node)];
-    add_targets(model, p, w, "POSITION", pos);
-    if (!mesh.normals.empty()) add_targets(model, p, w, "NORMAL", nrm);
-    if (!mesh.tangents.empty()) add_targets(model, p, w, "TANGENT", tan);
-    // The skin (section 3.7.3): world-space vertices; the mesh node's own transform does not apply.
-    if (n.skin >= 0 && p.attributes.count("JOINTS_0") && p.attributes.count("WEIGHTS_0")) {
-        const std::vector<Mat4d> m = skin_matrices(model, path, node, p, nv, pose);
-        for (size_t i = 0; i < nv; ++i) {
-            pos[i] = m[i].apply_point(pos[i]);
-            const Mat4d normal_matrix = m[i].inverse_affine().transposed();
-            nrm[i] = normal_matrix.apply_vector(nrm[i]);
-            tan[i] = m[i].apply_vector(tan[i]);
-        }
+    const bool morphed = !p.targets.empty() && std::any_of(w.begin(), w.end(), [](float x) { return x != 0.f; });
+    std::vector<Vec3d> pos, nrm, tan;
+    if (morphed) {
+        pos.resize(nv);
+        nrm.resize(nv);
+        tan.resize(nv);
+        for (size_t i = 0; i < nv; ++i) pos[i] = Vec3d(mesh.positions[i]);
+        for (size_t i = 0; i < mesh.normals.size() && i < nv; ++i) nrm[i] = Vec3d(mesh.normals[i]);
+        for (size_t i = 0; i < mesh.tangents.size() && i < nv; ++i) tan[i] = Vec3d(mesh.tangents[i].xyz());
+        add_targets(model, p, w, "POSITION", pos);
+        if (!mesh.normals.empty()) add_targets(model, p, w, "NORMAL", nrm);
+        if (!mesh.tangents.empty()) add_targets(model, p, w, "TANGENT", tan);
     }
-    for (size_t i = 0; i < nv; ++i) mesh.positions[i] = Vec3f(pos[i]);
+    // The skin (section 3.7.3): world-space vertices; the mesh node's own transform does not apply.
+    SkinBinding own;
+    if (!binding) {
+        own = skin_binding(model, path, node, primitive, nv);
+        binding = &own;
+    }
+    const bool skinned = binding->skinned;
+    const std::vector<Mat4d> joint = skinned ? joint_matrices(model, path, n.skin, pose) : std::vector<Mat4d>{};
     auto unit = [](const Vec3d& v, const Vec3f& fallback) {
         const double l = length(v);
         return l > 1e-30 && std::isfinite(l) ? Vec3f(v / l) : fallback;
     };
-    for (size_t i = 0; i < mesh.normals.size() && i < nv; ++i) mesh.normals[i] = unit(nrm[i], mesh.normals[i]);
-    for (size_t i = 0; i < mesh.tangents.size() && i < nv; ++i)
-        mesh.tangents[i] = Vec4f(unit(tan[i], mesh.tangents[i].xyz()), mesh.tangents[i].w);
+    const bool normals = mesh.normals.size() >= nv, tangents = mesh.tangents.size() >= nv;
+    // Each vertex on its own: in parallel, the same numbers whatever the split.
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            Vec3d v = morphed ? pos[i] : Vec3d(mesh.positions[i]);
+            Vec3d nv3 = !normals ? Vec3d(0.0) : morphed ? nrm[i] : Vec3d(mesh.normals[i]);
+            Vec3d tv = !tangents ? Vec3d(0.0) : morphed ? tan[i] : Vec3d(mesh.tangents[i].xyz());
+            if (skinned) {
+                const Mat4d m = blend_joints(*binding, joint, i);
+                v = m.apply_point(v);
+                nv3 = transform_normal(m, nv3);
+                tv = m.apply_vector(tv);
+            }
+            mesh.positions[i] = Vec3f(v);
+            if (normals) mesh.normals[i] = unit(nv3, mesh.normals[i]);
+            if (tangents) mesh.tangents[i] = Vec4f(unit(tv, mesh.tangents[i].xyz()), mesh.tangents[i].w);
+        }
+    });
 }
 
 void describe_animation(const tinygltf::Model& model, const std::vector<int>& posed, Scene& scene) {

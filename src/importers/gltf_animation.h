@@ -61,13 +61,28 @@ bool deformed(const tinygltf::Model& model, int node, int primitive);
 /// animated, or one of its skin's joints moves.
 bool deforming(const tinygltf::Model& model, int node, const GltfPose& pose);
 
+/// A skinned primitive's joints and weights per vertex (every JOINTS_n/WEIGHTS_n set, 4 influences
+/// a set), read and checked once: a sequence poses the mesh from it every frame.
+struct SkinBinding {
+    bool skinned = false;          ///< the node has a skin and the primitive JOINTS_0 and WEIGHTS_0
+    size_t influences = 0;         ///< per vertex
+    std::vector<uint32_t> joints;  ///< vertex-major, `influences` per vertex (0 where the weight is 0)
+    std::vector<float> weights;
+};
+
+/// The binding of node `node`'s `primitive` with `vertices` vertices (not skinned: empty). Throws
+/// whitted::Error naming the JOINTS accessor for a joint index outside the skin.
+SkinBinding skin_binding(const tinygltf::Model& model, const std::string& path, int node, int primitive,
+                         size_t vertices);
+
 /// Deforms `mesh`, built from `primitive` of node `node`'s mesh, to the pose: morph targets first
 /// (POSITION, NORMAL, TANGENT displacements times the node's weights), then the skin (each vertex by
 /// its weighted joint matrices global(joint) x inverseBindMatrix, normals by their inverse
-/// transpose, tangents by the 3x3), in world space for a skinned mesh. Throws whitted::Error for
-/// joint indices outside the skin.
+/// transpose, tangents by the 3x3), in world space for a skinned mesh; the vertices in parallel.
+/// `binding`: skin_binding() of the primitive, read here when null. Throws whitted::Error for joint
+/// indices outside the skin.
 void deform_mesh(Mesh& mesh, const tinygltf::Model& model, const std::string& path, int node, int primitive,
-                 const GltfPose& pose);
+                 const GltfPose& pose, const SkinBinding* binding = nullptr);
 
 /// The file's animations, skins and morphed meshes as Scene records (`posed`: the chosen ones).
 void describe_animation(const tinygltf::Model& model, const std::vector<int>& posed, Scene& scene);

@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <numbers>
 #include <numeric>
 #include <optional>
@@ -465,6 +466,12 @@ private:
     void repose_meshes(Scene& scene, SceneUpdate& u) {
         for (size_t i = 0; i < m_rest.size(); ++i)
             if (!m_rest[i].positions.empty()) u.meshes.push_back(uint32_t(i));
+        // Each skinned mesh's joints and weights read once, for the whole sequence.
+        m_bindings.resize(m_rest.size());
+        for (const uint32_t m : u.meshes)
+            if (!m_bindings[m])
+                m_bindings[m] = std::make_unique<const SkinBinding>(skin_binding(
+                    m_model, m_path, m_requests[m].node, m_requests[m].primitive, m_rest[m].positions.size()));
         std::vector<WarningLog> logs(u.meshes.size());
         tbb::parallel_for(size_t(0), u.meshes.size(), [&](size_t d) {
             Mesh& rest = m_rest[u.meshes[d]];
@@ -473,7 +480,7 @@ private:
             posed.normals = rest.normals;
             posed.tangents = rest.tangents;
             posed.indices = std::move(rest.indices);  // borrowed (smooth normals, zero-area count)
-            finish_geometry(m_requests[u.meshes[d]], posed, logs[d], false);
+            finish_geometry(m_requests[u.meshes[d]], posed, logs[d], false, m_bindings[u.meshes[d]].get());
             rest.indices = std::move(posed.indices);
             Mesh& out = scene.meshes[u.meshes[d]];
             std::copy(posed.positions.begin(), posed.positions.end(), out.positions.begin());
@@ -1328,9 +1335,10 @@ private:
     /// skin and morph weights; normals computed when the file has none), its numbers sanitised, its
     /// winding mirrored for a mirroring transform.
     /// `winding` false: the indices are left as they are (repose() borrows the rest pose's).
-    void finish_geometry(const MeshKey& k, Mesh& mesh, WarningLog& log, bool winding = true) const {
+    void finish_geometry(const MeshKey& k, Mesh& mesh, WarningLog& log, bool winding = true,
+                         const SkinBinding* binding = nullptr) const {
         if (k.node >= 0) {
-            deform_mesh(mesh, m_model, m_path, k.node, k.primitive, m_pose);
+            deform_mesh(mesh, m_model, m_path, k.node, k.primitive, m_pose, binding);
             if (!primitive(k).attributes.count("NORMAL")) mesh.normals = smooth_normals(mesh);
         }
         report_mesh_numbers(sanitize_mesh_numbers(mesh), mesh_pointer(k), log);
@@ -1434,6 +1442,7 @@ private:
     std::map<MeshKey, uint32_t> m_mesh_map;                 ///< -> Scene mesh
     std::vector<MeshKey> m_requests;                        ///< Scene mesh -> what it is built from
     std::vector<Mesh> m_rest;       ///< per Scene mesh: a deforming one's geometry before the pose (else empty)
+    std::vector<std::unique_ptr<const SkinBinding>> m_bindings;  ///< per Scene mesh: its skin, read at the first repose()
     int m_default_material = -1;
 };
 
