@@ -19,6 +19,8 @@ struct Command {
 Command register_bench_aa(CLI::App& bench);
 /// `whitted bench accel`: build time, memory and Mrays/s of every accelerator (bench_accel.cpp).
 Command register_bench_accel(CLI::App& bench);
+/// `whitted bench anim`: per-frame update of an animated scene against a rebuild and a render (bench_anim.cpp).
+Command register_bench_anim(CLI::App& bench);
 /// `whitted bench env`: display error and time of N lights extracted from an environment (bench_env.cpp).
 Command register_bench_env(CLI::App& bench);
 /// `whitted bench process`: whole runs, start to file written, with their split (bench_process.cpp).

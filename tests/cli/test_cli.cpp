@@ -13,6 +13,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -306,6 +308,31 @@ TEST(Cli, FramesAreTheSeparateRenders) {
         EXPECT_EQ(whitted::test::read_pixels(frame), whitted::test::read_pixels(dir / "one.exr")) << "frame " << k;
     }
     EXPECT_NE(whitted::test::read_pixels(dir / "f_01.exr"), whitted::test::read_pixels(dir / "f_03.exr"));
+    // A glTF file is loaded once and posed in place per frame (the skinned mesh refit): SimpleSkin
+    // with a camera node added, the same again.
+    const fs::path skin_dir = fs::path(WHITTED_ASSETS_DIR) / "gltf/SimpleSkin/glTF";
+    for (const auto& e : fs::directory_iterator(skin_dir))
+        fs::copy_file(e.path(), dir / e.path().filename(), fs::copy_options::overwrite_existing);
+    nlohmann::json gltf = nlohmann::json::parse(std::ifstream(skin_dir / "SimpleSkin.gltf"));
+    gltf["cameras"] = nlohmann::json::array({{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.01}}}}});
+    gltf["nodes"].push_back({{"camera", 0}, {"translation", {0.5, 1.0, 4.0}}});
+    gltf["scenes"][0]["nodes"].push_back(gltf["nodes"].size() - 1);
+    const fs::path skin = dir / "skin_camera.gltf";
+    std::ofstream(skin) << gltf.dump();
+    for (const char* accel : {"embree", "bvh"}) {
+        r = run("render '" + skin.string() + "'" + common + " --accel " + accel + " --frames 0-3 --fps 2 -o '" +
+                (dir / "s#.exr").string() + "'");
+        ASSERT_EQ(r.code, 0) << r.err;
+        for (int k = 0; k <= 3; ++k) {
+            r = run("render '" + skin.string() + "'" + common + " --accel " + accel + " --time " +
+                    std::to_string(k * 0.5) + " -o '" + (dir / "one.exr").string() + "'");
+            ASSERT_EQ(r.code, 0) << r.err;
+            EXPECT_EQ(whitted::test::read_pixels(dir / ("s" + std::to_string(k) + ".exr")),
+                      whitted::test::read_pixels(dir / "one.exr"))
+                << accel << " frame " << k;
+        }
+        EXPECT_NE(whitted::test::read_pixels(dir / "s0.exr"), whitted::test::read_pixels(dir / "s3.exr"));
+    }
     // A turntable of a static file: frame 0 is the plain render, the next ones turn.
     r = run("render '" + kBox + "'" + common + " --frames 0-1 --orbit 90 -o '" + (dir / "t#.exr").string() + "'");
     ASSERT_EQ(r.code, 0) << r.err;
