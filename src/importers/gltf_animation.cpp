@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <numbers>
 #include <set>
@@ -93,7 +94,10 @@ public:
     SamplerReader(const tinygltf::Model& model, const std::string& file) : m_model(model), m_file(file) {}
 
     /// `label` names the animated property in messages (default: the path's name).
-    AnimationSampler read(int a, int s, AnimationPath path, int components, const char* label = nullptr) const {
+    /// `output_type`: the accessor type the values must have when not the path's (a VEC2 texture
+    /// offset or scale of KHR_animation_pointer), FLOAT only.
+    AnimationSampler read(int a, int s, AnimationPath path, int components, const char* label = nullptr,
+                          int output_type = 0) const {
         const std::string ptr = fmt::format("/animations/{}/samplers/{}", a, s);
         const tinygltf::AnimationSampler& g = m_model.animations[size_t(a)].samplers[size_t(s)];
         AnimationSampler out;
@@ -109,10 +113,11 @@ public:
         for_each_element(accessor_data(m_model, g.input), [&](size_t i, const float* v) { out.times[i] = v[0]; });
         const tinygltf::Accessor& o = accessor(g.output, ptr + "/output");
         const bool normalized_int = o.normalized && o.componentType != kFloat;
-        const int expected_type = path == AnimationPath::Weights ? TINYGLTF_TYPE_SCALAR
+        const int expected_type = output_type                       ? output_type
+                                  : path == AnimationPath::Weights  ? TINYGLTF_TYPE_SCALAR
                                   : path == AnimationPath::Rotation ? TINYGLTF_TYPE_VEC4
                                                                     : TINYGLTF_TYPE_VEC3;
-        const bool int_ok = path == AnimationPath::Rotation || path == AnimationPath::Weights;
+        const bool int_ok = !output_type && (path == AnimationPath::Rotation || path == AnimationPath::Weights);
         if (o.type != expected_type || !(o.componentType == kFloat || (int_ok && normalized_int)))
             fail(ptr + "/output", "{} values must be a {} FLOAT{} accessor (accessor {} is {} {})",
                  label ? label : path_name(path),
@@ -205,7 +210,7 @@ bool indexed_pointer(const std::string& pointer, const std::string& prefix, cons
 }
 
 /// The value at time `t` of a KHR_animation_pointer channel's sampler: `components` floats (a
-/// SCALAR or VEC3/VEC4 accessor), interpolated component by component; `label` names the property.
+/// SCALAR or VEC2/VEC3/VEC4 accessor), interpolated component by component; `label` names the property.
 std::vector<float> sample_pointer(const tinygltf::Model& model, const SamplerReader& reader, int a,
                                   const tinygltf::AnimationChannel& ch, const std::string& ptr, double t,
                                   int components, const char* label) {
@@ -214,7 +219,8 @@ std::vector<float> sample_pointer(const tinygltf::Model& model, const SamplerRea
     const AnimationPath as = components == 1   ? AnimationPath::Weights      // a SCALAR accessor
                              : components == 3 ? AnimationPath::Translation  // VEC3
                                                : AnimationPath::Rotation;    // VEC4
-    const AnimationSampler s = reader.read(a, ch.sampler, as, components, label);
+    const AnimationSampler s =
+        reader.read(a, ch.sampler, as, components, label, components == 2 ? TINYGLTF_TYPE_VEC2 : 0);
     std::vector<float> v(static_cast<size_t>(components));
     // Not a rotation: no quaternion interpolation for 4 components.
     sample_animation(s, as == AnimationPath::Rotation ? AnimationPath::Translation : as, float(t), v.data());
@@ -269,11 +275,34 @@ constexpr MaterialProperty kMaterialProperties[] = {
     {"occlusionTexture/strength", 1, 0.f, 1.f},
 };
 
-/// Applies a KHR_animation_pointer channel to a core material property ("/materials/N/..."); false
-/// when the pointer is not one of kMaterialProperties.
+/// The core textureInfo slots of a material, and the KHR_texture_transform properties of each that
+/// KHR_animation_pointer may animate (any finite value).
+constexpr const char* kTextureSlots[] = {"pbrMetallicRoughness/baseColorTexture",
+                                         "pbrMetallicRoughness/metallicRoughnessTexture", "normalTexture",
+                                         "occlusionTexture", "emissiveTexture"};
+constexpr MaterialProperty kTextureTransformProperties[] = {
+    {"offset", 2, -3.4e38f, 3.4e38f}, {"rotation", 1, -3.4e38f, 3.4e38f}, {"scale", 2, -3.4e38f, 3.4e38f}};
+constexpr const char* kTextureTransform = "/extensions/KHR_texture_transform/";
+
+/// Applies a KHR_animation_pointer channel to a core material property ("/materials/N/..."): a
+/// factor of kMaterialProperties or a KHR_texture_transform property of a core texture slot; false
+/// for other pointers.
 bool apply_material_pointer(const tinygltf::Model& model, const SamplerReader& reader, const std::string& pointer,
                             int a, const tinygltf::AnimationChannel& ch, const std::string& ptr, double t,
                             GltfPose& pose) {
+    for (const char* slot : kTextureSlots)
+        for (const MaterialProperty& p : kTextureTransformProperties) {
+            const std::string property = std::string(slot) + kTextureTransform + p.path;
+            int index = -1;
+            if (!indexed_pointer(pointer, "/materials/", "/" + property, index)) continue;
+            if (size_t(index) >= model.materials.size())
+                reader.fail(ptr + "/target", "{} points at a material that does not exist", pointer);
+            std::vector<float> v = sample_pointer(model, reader, a, ch, ptr, t, p.components, p.path);
+            for (const float x : v)
+                if (!std::isfinite(x)) reader.fail(ptr, "texture transform {} is {} at {} s", p.path, x, t);
+            pose.values.push_back({GltfPose::Collection::Materials, index, property, std::move(v)});
+            return true;
+        }
     for (const MaterialProperty& p : kMaterialProperties) {
         int index = -1;
         if (!indexed_pointer(pointer, "/materials/", std::string("/") + p.path, index)) continue;
@@ -430,6 +459,33 @@ GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const
     return pose;
 }
 
+namespace {
+
+/// Writes `property` ("offset", "rotation" or "scale") of the KHR_texture_transform of material
+/// `g`'s texture `slot` (kTextureSlots), adding the extension object where the file has none.
+void set_texture_transform(tinygltf::Material& g, const std::string& slot, const std::string& property,
+                           const std::vector<double>& value) {
+    tinygltf::ExtensionMap* extensions = slot == "pbrMetallicRoughness/baseColorTexture"
+                                             ? &g.pbrMetallicRoughness.baseColorTexture.extensions
+                                         : slot == "pbrMetallicRoughness/metallicRoughnessTexture"
+                                             ? &g.pbrMetallicRoughness.metallicRoughnessTexture.extensions
+                                         : slot == "normalTexture"    ? &g.normalTexture.extensions
+                                         : slot == "occlusionTexture" ? &g.occlusionTexture.extensions
+                                                                      : &g.emissiveTexture.extensions;
+    tinygltf::Value& xf = (*extensions)["KHR_texture_transform"];
+    tinygltf::Value::Object members = xf.IsObject() ? xf.Get<tinygltf::Value::Object>() : tinygltf::Value::Object{};
+    if (value.size() == 1) {
+        members[property] = tinygltf::Value(value[0]);
+    } else {
+        tinygltf::Value::Array a;
+        for (const double x : value) a.emplace_back(x);
+        members[property] = tinygltf::Value(std::move(a));
+    }
+    xf = tinygltf::Value(std::move(members));
+}
+
+}  // namespace
+
 void apply_pointer_values(const GltfPose& pose, tinygltf::Model& model) {
     for (const GltfPose::PointerValue& m : pose.values) {
         const std::vector<double> d(m.value.begin(), m.value.end());
@@ -444,6 +500,10 @@ void apply_pointer_values(const GltfPose& pose, tinygltf::Model& model) {
             continue;
         }
         tinygltf::Material& g = model.materials[size_t(m.index)];
+        if (const size_t at = m.property.find(kTextureTransform); at != std::string::npos) {
+            set_texture_transform(g, m.property.substr(0, at), m.property.substr(at + std::strlen(kTextureTransform)), d);
+            continue;
+        }
         if (m.property == "pbrMetallicRoughness/baseColorFactor") g.pbrMetallicRoughness.baseColorFactor = d;
         else if (m.property == "pbrMetallicRoughness/metallicFactor") g.pbrMetallicRoughness.metallicFactor = d[0];
         else if (m.property == "pbrMetallicRoughness/roughnessFactor") g.pbrMetallicRoughness.roughnessFactor = d[0];

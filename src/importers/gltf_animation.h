@@ -48,9 +48,9 @@ std::vector<int> choose_animations(const tinygltf::Model& model, const std::stri
 /// with morph weights from the animation, else node.weights, else mesh.weights, else 0. Validates
 /// what it reads and throws whitted::Error naming the file, the animation or node and the problem
 /// (key times, value counts, targets, weights counts). KHR_animation_pointer channels apply to node
-/// translation, rotation, scale and weights, camera yfov, light color and intensity, and the core
-/// material factors (written into the model by apply_pointer_values); others are skipped with one
-/// warning each.
+/// translation, rotation, scale and weights, camera yfov, light color and intensity, the core
+/// material factors and the KHR_texture_transform offset, rotation and scale of the core texture
+/// slots (written into the model by apply_pointer_values); others are skipped with one warning each.
 GltfPose pose_nodes(const tinygltf::Model& model, const std::string& path, const std::vector<int>& animations,
                     double time, bool loop, WarningLog& warnings);
 

@@ -8,6 +8,8 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <fstream>
+#include <filesystem>
 #include <fmt/format.h>
 
 #include "tests/support/test_importer_util.h"
@@ -186,7 +188,8 @@ TEST(GltfAnimation, LinearTranslationInterpolatesAndReplacesTheNodeTranslation) 
 
 // KHR_animation_pointer: a pointer to a node's translation animates it like a core channel (in a
 // GLB, whose JSON chunk is rewritten before tinygltf parses it); a pointer whitted does not apply
-// (a texture transform) is one warning naming it, and the rest of the animation still applies.
+// (an extension of a node it does not know) is one warning naming it, and the rest of the
+// animation still applies.
 TEST(GltfAnimation, AnimationPointerToANodeAnimatesIt) {
     Glb b;
     const int pos = b.floats(kTriangle, "VEC3", true);
@@ -200,15 +203,65 @@ TEST(GltfAnimation, AnimationPointerToANodeAnimatesIt) {
           "channels":[{"sampler":0,"target":{"path":"pointer",
                          "extensions":{"KHR_animation_pointer":{"pointer":"/nodes/0/translation"}}}},
                       {"sampler":1,"target":{"path":"pointer",
-                         "extensions":{"KHR_animation_pointer":{"pointer":"/materials/0/pbrMetallicRoughness/baseColorTexture/extensions/KHR_texture_transform/offset"}}}}]}])",
+                         "extensions":{"KHR_animation_pointer":{"pointer":"/nodes/0/extensions/EXT_whatever/value"}}}}]}])",
                                 {{"pos", pos}, {"in", in}, {"out", out}, {"color", color}}));
     EXPECT_VEC3_NEAR(translation_at(glb, 0.25), 0.5, 0.0, 0.0, 1e-6);
     const Scene s = import(glb, at_time(0.75));
     EXPECT_VEC3_NEAR(origin_of(instance_of(s, "tri").world_from_object), 1.5, 0.0, 0.0, 1e-6);
     size_t warned = 0;
     for (const std::string& w : s.warnings)
-        warned += w.find("KHR_texture_transform/offset is not applied") != std::string::npos;
+        warned += w.find("/nodes/0/extensions/EXT_whatever/value is not applied") != std::string::npos;
     EXPECT_EQ(warned, 1u);
+}
+
+// KHR_animation_pointer to KHR_texture_transform: the base colour texture's offset (VEC2, LINEAR
+// from (0,0) to (1,0.5): halfway at 0.5 s) where the file has the extension object (its scale
+// kept), and the normal texture's rotation (SCALAR, 0 to 1) where it has none (added).
+TEST(GltfAnimation, AnimationPointerToTextureTransforms) {
+    Glb b;
+    const int pos = b.floats(kTriangle, "VEC3", true);
+    const int uv = b.floats({0, 0, 1, 0, 0, 1}, "VEC2");
+    const int in = b.floats({0, 1}, "SCALAR", true);
+    const int offset = b.floats({0, 0, 1, 0.5f}, "VEC2");
+    const int angle = b.floats({0, 1}, "SCALAR");
+    const std::string png = "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg==";
+    const auto glb = b.glb(fill(R"("scene":0,"scenes":[{"nodes":[0]}],"extensionsUsed":["KHR_animation_pointer","KHR_texture_transform"],
+        "nodes":[{"name":"tri","mesh":0}],"images":[{"uri":"@png@"}],"textures":[{"source":0}],
+        "materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0,
+                        "extensions":{"KHR_texture_transform":{"scale":[2,3]}}}},
+                      "normalTexture":{"index":0}}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":@pos@,"TEXCOORD_0":@uv@},"material":0}]}],
+        "animations":[{"samplers":[{"input":@in@,"output":@offset@},{"input":@in@,"output":@angle@}],
+          "channels":[{"sampler":0,"target":{"path":"pointer",
+                         "extensions":{"KHR_animation_pointer":{"pointer":"/materials/0/pbrMetallicRoughness/baseColorTexture/extensions/KHR_texture_transform/offset"}}}},
+                      {"sampler":1,"target":{"path":"pointer",
+                         "extensions":{"KHR_animation_pointer":{"pointer":"/materials/0/normalTexture/extensions/KHR_texture_transform/rotation"}}}}]}])",
+                                {{"pos", pos}, {"uv", uv}, {"in", in}, {"offset", offset}, {"angle", angle}, {"png", png}}));
+    const Scene half = import(glb, at_time(0.5));
+    ASSERT_GE(half.materials.size(), 1u);
+    const TextureTransform& base = half.materials[0].base_color_texture.transform;
+    EXPECT_NEAR(base.offset.x, 0.5, 1e-6);
+    EXPECT_NEAR(base.offset.y, 0.25, 1e-6);
+    EXPECT_EQ(base.scale.x, 2.f);  // the file's, kept
+    EXPECT_EQ(base.scale.y, 3.f);
+    EXPECT_NEAR(half.materials[0].normal_texture.transform.rotation, 0.5, 1e-6);
+    const Scene start = import(glb, at_time(0.0));
+    EXPECT_TRUE(start.materials[0].normal_texture.transform.identity());
+    EXPECT_EQ(start.materials[0].base_color_texture.transform.offset.x, 0.f);
+    for (const std::string& w : half.warnings) EXPECT_EQ(w.find("is not applied"), std::string::npos) << w;
+
+    // A sequence poses the same transforms in place, and says the materials changed.
+    const std::filesystem::path path = std::filesystem::temp_directory_path() / "whitted_texture_transform_anim.glb";
+    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(glb.data()), std::streamsize(glb.size()));
+    AnimatedScene anim = import_gltf_animated(path.string(), at_time(0.0));
+    const SceneUpdate u = anim.animator->pose(anim.scene, 0.5);
+    std::filesystem::remove(path);
+    EXPECT_TRUE(u.materials);
+    EXPECT_FALSE(u.reloaded);
+    const TextureTransform& posed = anim.scene.materials[0].base_color_texture.transform;
+    EXPECT_EQ(posed.offset, base.offset);
+    EXPECT_EQ(posed.scale, base.scale);
+    EXPECT_EQ(anim.scene.materials[0].normal_texture.transform.rotation, half.materials[0].normal_texture.transform.rotation);
 }
 
 // KHR_animation_pointer to core material factors: baseColorFactor (VEC4, component by component,
