@@ -368,8 +368,9 @@ PYBIND11_MODULE(whitted, m) {
         [](const std::string& path, int scene_index, const std::string& environment,
            std::optional<float> env_rotate, std::optional<float> env_exposure, int env_lights, bool no_environment,
            bool default_light, bool default_camera, bool allow_outside_uris, double max_memory_gb, double time,
-           const std::string& animation, bool loop) {
+           const std::string& animation, bool loop, const std::string& variant) {
             ImportOptions io;
+            io.variant = variant;
             check_animation_time(time, "time");
             io.time = time;
             io.animation = animation;
@@ -396,9 +397,10 @@ PYBIND11_MODULE(whitted, m) {
         py::arg("env_exposure") = py::none(), py::arg("env_lights") = kDefaultEnvironmentLights,
         py::arg("no_environment") = false, py::arg("default_light") = true, py::arg("default_camera") = true,
         py::arg("allow_outside_uris") = false, py::arg("max_memory_gb") = 8.0, py::arg("time") = 0.0,
-        py::arg("animation") = "all", py::arg("loop") = false,
+        py::arg("animation") = "all", py::arg("loop") = false, py::arg("variant") = "",
         "Loads a .gltf, .glb or .json scene file (the options of `whitted render`'s import flags; an animated "
-        "glTF posed at `time` seconds under `animation`: 'all', a name or indices '0,2'); raises "
+        "glTF posed at `time` seconds under `animation`: 'all', a name or indices '0,2'; `variant`: a "
+        "KHR_materials_variants variant by name); raises "
         "whitted.Error naming the file and the problem");
 
     m.def(

@@ -159,6 +159,9 @@ CLI::App* add_animation_options(CLI::App* app, ImportOptions& io) {
     g->add_option("--animation", io.animation, "Animations applied: all, a name, or indices (0,2)")
         ->capture_default_str();
     g->add_flag("--loop", io.loop, "Each animation repeats after its duration instead of holding its last key");
+    app->add_option("--variant", io.variant,
+                    "KHR_materials_variants: the variant whose materials apply (by name; `whitted info` lists them; "
+                    "default: the file's default materials)");
     return g;
 }
 

@@ -216,3 +216,12 @@ def test_load_poses_an_animated_file_at_a_time():
         whitted.load(tri, animation="walk")
     with pytest.raises(whitted.Error, match="time"):
         whitted.load(tri, time=float("nan"))
+
+
+def test_load_takes_a_material_variant():
+    # Box has no KHR_materials_variants: naming one is an error naming the file (the mapping
+    # itself is tested in C++, GltfVariants.*).
+    box = os.path.join(ASSETS, "gltf", "Box", "glTF-Binary", "Box.glb")
+    assert whitted.load(box, variant="").info()["text"]
+    with pytest.raises(whitted.Error, match="Box.glb.*variant 'beach': the file has no KHR_materials_variants"):
+        whitted.load(box, variant="beach")

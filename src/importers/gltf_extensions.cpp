@@ -41,7 +41,7 @@ constexpr std::array kTable = {
     Entry{"KHR_materials_anisotropy", I, false, "highlights stay isotropic"},
     Entry{"KHR_materials_dispersion", I, false, "one index of refraction for all wavelengths"},
     Entry{"KHR_materials_diffuse_transmission", I, false, "diffuse transmission not rendered"},
-    Entry{"KHR_materials_variants", I, false, "each primitive keeps its default material"},
+    Entry{"KHR_materials_variants", S, false, "--variant NAME applies a variant's materials; default materials otherwise"},
     Entry{"KHR_materials_pbrSpecularGlossiness", I, true, "core metallic-roughness values used instead"},
     Entry{"KHR_xmp", I, false, "metadata not read"},
     Entry{"KHR_xmp_json_ld", I, false, "metadata not read"},

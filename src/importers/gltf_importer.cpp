@@ -34,6 +34,7 @@
 #include "importers/file_bytes.h"
 #include "importers/gltf_accessor.h"
 #include "importers/gltf_animation.h"
+#include "importers/gltf_variants.h"
 #include "importers/gltf_extensions.h"
 #include "importers/gltf_json.h"
 #include "importers/gltf_compressed.h"
@@ -398,6 +399,7 @@ public:
         validate_gltf(m_model, m_path, m_options.max_memory, m_scene);
         check_images_present();
         classify_extensions();
+        choose_variant();
         pose();
         convert_materials();
         traverse_scene();
@@ -461,6 +463,14 @@ public:
     }
 
 private:
+    /// KHR_materials_variants: the chosen variant's materials written into the primitives before
+    /// anything reads them; the file's variants recorded for `whitted info`.
+    void choose_variant() {
+        if (!m_options.variant.empty()) apply_material_variant(m_model, m_path, m_options.variant);
+        m_scene.variants = material_variants(m_model);
+        m_scene.variant = m_options.variant;
+    }
+
     /// repose(): each deforming mesh posed from its rest geometry, in parallel; the vertices are
     /// written into the Scene's arrays in place.
     void repose_meshes(Scene& scene, SceneUpdate& u) {

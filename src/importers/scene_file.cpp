@@ -1015,7 +1015,8 @@ private:
 
     void read_include(const Json& o, const std::string& ptr) {
         check_object(o, ptr, "an include",
-                     {"file", "transform", "scene", "materials", "lights", "cameras", "animation", "time_offset", "comment"});
+                     {"file", "transform", "scene", "materials", "lights", "cameras", "animation", "time_offset", "variant",
+                      "comment"});
         const std::string fp = sub(ptr, "file");
         const std::string file = string(require(o, "file", ptr, "an include", "a .gltf or .glb file name"), fp);
         const std::string ext = lower_ext(file);
@@ -1032,6 +1033,10 @@ private:
         // Its animations: which, and at what time (the render's time plus the offset; glTF key
         // times are not negative, so an earlier moment is the first key's).
         if (const Json* a = member(o, "animation")) sub_options.animation = string(*a, sub(ptr, "animation"));
+        // A KHR_materials_variants variant of the included file (the render's --variant is the
+        // top file's: a scene file has none, so it does not pass down).
+        sub_options.variant.clear();
+        if (const Json* v = member(o, "variant")) sub_options.variant = string(*v, sub(ptr, "variant"));
         if (const Json* t = member(o, "time_offset"))
             sub_options.time = std::max(0.0, m_options.time + number(*t, sub(ptr, "time_offset")));
         sub_options.max_memory = m_options.max_memory > m_bytes ? m_options.max_memory - m_bytes : 0;

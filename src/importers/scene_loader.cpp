@@ -31,7 +31,8 @@ std::vector<std::pair<std::string, std::string>> describe_import_options(const I
             {"env_lights", std::to_string(o.environment_lights)},
             {"time", fmt::format("{:.17g}", o.time)},
             {"animation", o.animation},
-            {"loop", flag(o.loop)}};
+            {"loop", flag(o.loop)},
+            {"variant", o.variant.empty() ? "default" : o.variant}};
 }
 
 void check_animation_time(double time, const std::string& what) {
@@ -87,10 +88,19 @@ private:
     ImportOptions m_options;
 };
 
+/// A variant names a glTF file's materials: a scene file names one per include instead.
+void check_variant(const std::string& path, const std::string& ext, const ImportOptions& options) {
+    if (ext == ".json" && !options.variant.empty())
+        throw Error(file_loc(path, ""), fmt::format("variant '{}': a scene file has no variants; name one per "
+                                                    "included glTF file (\"variant\" in its include)",
+                                                    options.variant));
+}
+
 }  // namespace
 
 Scene load_scene(const std::string& path, const ImportOptions& options) {
     const std::string ext = scene_extension(path);
+    check_variant(path, ext, options);
     Scene scene = ext == ".json" ? import_scene_file(path, options) : import_gltf(path, options);
     finish_scene(scene, path, ext, options);
     return scene;
@@ -98,6 +108,7 @@ Scene load_scene(const std::string& path, const ImportOptions& options) {
 
 AnimatedScene load_animated_scene(const std::string& path, const ImportOptions& options) {
     const std::string ext = scene_extension(path);
+    check_variant(path, ext, options);
     AnimatedScene a;
     if (ext == ".json") {
         a.scene = import_scene_file(path, options);

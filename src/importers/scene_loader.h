@@ -38,6 +38,8 @@ struct ImportOptions {
     double time = 0.0;                          ///< seconds; finite, >= 0
     std::string animation = "all";              ///< "all", a name, or indices "0,2": the animations applied
     bool loop = false;                          ///< each animation repeats after its duration (else it holds its last key)
+    // Materials (docs/gltf-support.md "Material variants").
+    std::string variant;                        ///< a KHR_materials_variants variant by name; empty = the default materials
 };
 
 /// The default camera of a scene without one (docs/lights.md): perspective, looking at the centre

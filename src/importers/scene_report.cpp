@@ -193,6 +193,10 @@ void describe_motion(const Scene& scene, const std::function<void(const std::str
         line(fmt::format("morph[{}]: mesh=\"{}\" targets={} default_weights={}", i, m.mesh, m.targets,
                          weights.empty() ? "0" : weights));
     }
+    // KHR_materials_variants: the file's material sets (--variant NAME).
+    for (size_t i = 0; i < scene.variants.size(); ++i)
+        line(fmt::format("variant[{}]: name=\"{}\" applied={}", i, scene.variants[i],
+                         yes_no(scene.variants[i] == scene.variant)));
 }
 
 }  // namespace

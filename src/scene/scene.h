@@ -349,6 +349,8 @@ struct Scene {
     std::vector<AnimationInfo> animations;  ///< the glTF file's animations (posed or not)
     std::vector<SkinInfo> skins;
     std::vector<MorphInfo> morphs;
+    std::vector<std::string> variants;  ///< the glTF file's KHR_materials_variants variants, in order
+    std::string variant;                ///< the one applied (empty: the default materials)
 
     /// Geometry ids (see GeomKind): meshes, then spheres, then planes.
     uint32_t sphere_geom_id(size_t sphere) const { return uint32_t(meshes.size() + sphere); }

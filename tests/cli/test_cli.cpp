@@ -73,6 +73,22 @@ TEST(Cli, MissingSceneFileIsOneLineNamingIt) {
     EXPECT_NE(r.err.find("/nonexistent/scene.gltf"), std::string::npos) << r.err;
 }
 
+// --variant on render and info: a file without KHR_materials_variants is one error line naming
+// it (the mapping itself: GltfVariants.* in test_gltf_variants), and nothing is written.
+TEST(Cli, VariantOfAFileWithoutVariantsIsOneLine) {
+    const std::string out = (std::filesystem::temp_directory_path() / "whitted_cli_variant.png").string();
+    std::filesystem::remove(out);
+    for (const std::string& cmd : {"render '" + kBox + "' --variant beach -o '" + out + "'",
+                                   "info '" + kBox + "' --variant beach"}) {
+        const Result r = run(cmd);
+        EXPECT_EQ(r.code, 1) << cmd;
+        EXPECT_NE(r.err.find("Box.glb"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("variant 'beach': the file has no KHR_materials_variants variants"), std::string::npos)
+            << r.err;
+    }
+    EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 TEST(Cli, BrokenGltfIsOneLineNamingTheFile) {
     const std::string bad = std::string(WHITTED_TEST_DATA_DIR) + "/gltf-invalid/validator/node/node_loop.gltf";
     Result r = run("info '" + bad + "'");
