@@ -43,6 +43,7 @@
 #include "importers/scene_loader.h"
 #include "integrator/render.h"
 #include "integrator/render_settings.h"
+#include "session/sequence.h"
 
 namespace whitted::app {
 
@@ -99,19 +100,11 @@ ImportOptions anim_import(double time) {
     return io;
 }
 
-double frame_time(int k, double fps) { return double(k) / fps; }
-
 /// The fixed camera of a sequence (as `render --frames`): when camera 0 is the default one, a
 /// default camera framing the bounds of frames 0 .. frames-1; the scene is left posed at frame 0.
 std::optional<Camera> sequence_camera(Scene& scene, SceneAnimator& animator, int frames, double fps) {
     if (scene.cameras.empty() || !scene.cameras[0].is_default) return std::nullopt;
-    Bounds3d all = scene.world_bounds();
-    for (int k = 1; k < frames; ++k) {
-        animator.pose(scene, frame_time(k, fps));
-        all.extend(scene.world_bounds());
-    }
-    if (frames > 1) animator.pose(scene, frame_time(0, fps));
-    Camera c = default_camera(all);
+    Camera c = default_camera(sequence_bounds(scene, animator, FrameRange{0, frames - 1, fps}));
     scene.cameras[0] = c;
     return c;
 }

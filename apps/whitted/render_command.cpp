@@ -269,13 +269,7 @@ int write_frame(RenderCommand& c, const Prepared& p, const FrameResult& frame, c
 std::optional<Bounds3d> sequence_bounds(Prepared& p, const RenderSettings& rs, const FrameRange& range) {
     if (rs.camera < 0 || size_t(rs.camera) >= p.scene.cameras.size() || !p.scene.cameras[size_t(rs.camera)].is_default)
         return std::nullopt;
-    Bounds3d all = p.scene.world_bounds();
-    for (int k = range.first + 1; k <= range.last; ++k) {
-        p.animator->pose(p.scene, frame_time(k, range.fps));
-        all.extend(p.scene.world_bounds());
-    }
-    if (range.count() > 1) p.animator->pose(p.scene, frame_time(range.first, range.fps));
-    return all;
+    return whitted::sequence_bounds(p.scene, *p.animator, range);
 }
 
 /// `render --frames A-B`: the scene loaded once and posed at each frame's time k / fps (only what

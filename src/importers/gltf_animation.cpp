@@ -280,8 +280,11 @@ constexpr MaterialProperty kMaterialProperties[] = {
 constexpr const char* kTextureSlots[] = {"pbrMetallicRoughness/baseColorTexture",
                                          "pbrMetallicRoughness/metallicRoughnessTexture", "normalTexture",
                                          "occlusionTexture", "emissiveTexture"};
-constexpr MaterialProperty kTextureTransformProperties[] = {
-    {"offset", 2, -3.4e38f, 3.4e38f}, {"rotation", 1, -3.4e38f, 3.4e38f}, {"scale", 2, -3.4e38f, 3.4e38f}};
+struct TextureTransformProperty {
+    const char* path;
+    int components;
+};
+constexpr TextureTransformProperty kTextureTransformProperties[] = {{"offset", 2}, {"rotation", 1}, {"scale", 2}};
 constexpr const char* kTextureTransform = "/extensions/KHR_texture_transform/";
 
 /// Applies a KHR_animation_pointer channel to a core material property ("/materials/N/..."): a
@@ -291,7 +294,7 @@ bool apply_material_pointer(const tinygltf::Model& model, const SamplerReader& r
                             int a, const tinygltf::AnimationChannel& ch, const std::string& ptr, double t,
                             GltfPose& pose) {
     for (const char* slot : kTextureSlots)
-        for (const MaterialProperty& p : kTextureTransformProperties) {
+        for (const TextureTransformProperty& p : kTextureTransformProperties) {
             const std::string property = std::string(slot) + kTextureTransform + p.path;
             int index = -1;
             if (!indexed_pointer(pointer, "/materials/", "/" + property, index)) continue;

@@ -476,12 +476,6 @@ private:
     void repose_meshes(Scene& scene, SceneUpdate& u) {
         for (size_t i = 0; i < m_rest.size(); ++i)
             if (!m_rest[i].positions.empty()) u.meshes.push_back(uint32_t(i));
-        // Each skinned mesh's joints and weights read once, for the whole sequence.
-        m_bindings.resize(m_rest.size());
-        for (const uint32_t m : u.meshes)
-            if (!m_bindings[m])
-                m_bindings[m] = std::make_unique<const SkinBinding>(skin_binding(
-                    m_model, m_path, m_requests[m].node, m_requests[m].primitive, m_rest[m].positions.size()));
         std::vector<WarningLog> logs(u.meshes.size());
         tbb::parallel_for(size_t(0), u.meshes.size(), [&](size_t d) {
             Mesh& rest = m_rest[u.meshes[d]];
@@ -490,7 +484,7 @@ private:
             posed.normals = rest.normals;
             posed.tangents = rest.tangents;
             posed.indices = std::move(rest.indices);  // borrowed (smooth normals, zero-area count)
-            finish_geometry(m_requests[u.meshes[d]], posed, logs[d], false, m_bindings[u.meshes[d]].get());
+            finish_geometry(m_requests[u.meshes[d]], posed, logs[d], false, &m_bindings[u.meshes[d]]);
             rest.indices = std::move(posed.indices);
             Mesh& out = scene.meshes[u.meshes[d]];
             std::copy(posed.positions.begin(), posed.positions.end(), out.positions.begin());
@@ -1304,10 +1298,16 @@ private:
         std::vector<Mesh> built(unique.size());
         std::vector<WarningLog> logs(unique.size());
         m_rest.assign(n, Mesh{});
+        m_bindings.assign(n, SkinBinding{});
         tbb::parallel_for(size_t(0), unique.size(), [&](size_t u) {
             const MeshKey& k = m_requests[unique[u]];
             built[u] = build_geometry(primitive(k), mesh_pointer(k), logs[u]);
-            if (k.node >= 0 && deforming(m_model, k.node, m_pose)) m_rest[unique[u]] = built[u];  // for repose()
+            if (k.node >= 0 && deforming(m_model, k.node, m_pose)) {  // kept for repose()
+                m_rest[unique[u]] = built[u];
+                m_bindings[unique[u]] = skin_binding(m_model, m_path, k.node, k.primitive, built[u].positions.size());
+                finish_geometry(k, built[u], logs[u], true, &m_bindings[unique[u]]);
+                return;
+            }
             finish_geometry(k, built[u], logs[u]);
         });
 
@@ -1452,7 +1452,7 @@ private:
     std::map<MeshKey, uint32_t> m_mesh_map;                 ///< -> Scene mesh
     std::vector<MeshKey> m_requests;                        ///< Scene mesh -> what it is built from
     std::vector<Mesh> m_rest;       ///< per Scene mesh: a deforming one's geometry before the pose (else empty)
-    std::vector<std::unique_ptr<const SkinBinding>> m_bindings;  ///< per Scene mesh: its skin, read at the first repose()
+    std::vector<SkinBinding> m_bindings;  ///< per Scene mesh: a deforming one's skin (else empty), read once
     int m_default_material = -1;
 };
 

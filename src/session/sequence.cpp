@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "importers/scene_loader.h"
+#include "scene/scene.h"
 
 namespace whitted {
 
@@ -40,6 +42,16 @@ std::string frame_path(const std::string& pattern, int frame) {
     const size_t begin = before == std::string::npos ? 0 : before + 1;
     const size_t width = end + 1 - begin;
     return pattern.substr(0, begin) + fmt::format("{:0{}d}", frame, width) + pattern.substr(end + 1);
+}
+
+Bounds3d sequence_bounds(Scene& scene, SceneAnimator& animator, const FrameRange& range) {
+    Bounds3d all = scene.world_bounds();
+    for (int k = range.first + 1; k <= range.last; ++k) {
+        animator.pose(scene, frame_time(k, range.fps));
+        all.extend(scene.world_bounds());
+    }
+    if (range.count() > 1) animator.pose(scene, frame_time(range.first, range.fps));
+    return all;
 }
 
 }  // namespace whitted

@@ -5,7 +5,12 @@
 
 #include <string>
 
+#include "core/vecmath.h"
+
 namespace whitted {
+
+struct Scene;
+class SceneAnimator;
 
 /// Frames `first`..`last` (inclusive) at `fps` frames per second.
 struct FrameRange {
@@ -20,6 +25,11 @@ FrameRange parse_frame_range(const std::string& text, const std::string& flag = 
 
 /// Frame `frame`'s time in seconds: frame / fps, the same double `--time` parses from its decimal.
 inline double frame_time(int frame, double fps) { return double(frame) / fps; }
+
+/// The union of the scene's world bounds at every frame of `range`, posing `scene` with `animator`
+/// (load_animated_scene); afterwards the scene is posed at the first frame again. What the default
+/// camera of a sequence frames, fixed over the frames.
+Bounds3d sequence_bounds(Scene& scene, SceneAnimator& animator, const FrameRange& range);
 
 /// `pattern` with its (last) run of '#' replaced by `frame`, zero-padded to the run's length (wider
 /// numbers are written whole). Throws whitted::Error when `pattern` has no '#'.
