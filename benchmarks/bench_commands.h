@@ -23,6 +23,8 @@ Command register_bench_accel(CLI::App& bench);
 Command register_bench_anim(CLI::App& bench);
 /// `whitted bench env`: display error and time of N lights extracted from an environment (bench_env.cpp).
 Command register_bench_env(CLI::App& bench);
+/// `whitted bench materials`: each glTF material extension's sample with and without it (bench_materials.cpp).
+Command register_bench_materials(CLI::App& bench);
 /// `whitted bench process`: whole runs, start to file written, with their split (bench_process.cpp).
 Command register_bench_process(CLI::App& bench);
 /// `whitted bench scale`: load/build/render time and memory per object against object count (bench_scale.cpp).

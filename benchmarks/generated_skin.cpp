@@ -5,14 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
-#include <fstream>
 #include <numbers>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
 
+#include "benchmarks/glb_writer.h"
 #include "core/error.h"
 
 namespace whitted::app {
@@ -33,38 +32,6 @@ double bspline(double t) {
     return 0.0;
 }
 
-/// The binary buffer, built view by view (each 4-byte aligned), and the JSON of its views and accessors.
-struct Layout {
-    std::vector<uint8_t> bin;
-    std::vector<std::string> views, accessors;
-
-    /// Appends `count` elements of `bytes` each as a view (with `target` when non-zero) and one
-    /// accessor over it; returns the accessor index.
-    template <typename T>
-    int add(const std::vector<T>& data, int component, const char* type, size_t count, int target,
-            const std::string& extra = "") {
-        const size_t offset = bin.size();
-        const size_t length = data.size() * sizeof(T);
-        bin.resize(offset + length);
-        std::memcpy(bin.data() + offset, data.data(), length);
-        bin.resize((bin.size() + 3) & ~size_t(3), 0);
-        views.push_back(fmt::format("{{\"buffer\": 0, \"byteOffset\": {}, \"byteLength\": {}{}}}", offset, length,
-                                    target ? fmt::format(", \"target\": {}", target) : ""));
-        accessors.push_back(fmt::format("{{\"bufferView\": {}, \"componentType\": {}, \"count\": {}, \"type\": \"{}\"{}}}",
-                                        views.size() - 1, component, count, type, extra));
-        return int(accessors.size() - 1);
-    }
-};
-
-std::string join(const std::vector<std::string>& items, const char* separator) {
-    std::string out;
-    for (size_t i = 0; i < items.size(); ++i) out += (i ? separator : "") + items[i];
-    return out;
-}
-
-void put_u32(std::string& s, uint32_t v) {
-    for (int b = 0; b < 4; ++b) s.push_back(char((v >> (8 * b)) & 0xFF));
-}
 
 }  // namespace
 
@@ -138,7 +105,7 @@ GeneratedSkin write_generated_skin(const std::filesystem::path& path, const Gene
     std::vector<float> times(size_t(spec.keys));
     for (int k = 0; k < spec.keys; ++k) times[size_t(k)] = float(spec.duration * k / (spec.keys - 1));
 
-    Layout l;
+    GlbLayout l;
     const std::string pos_bounds = fmt::format(", \"min\": [{}, {}, {}], \"max\": [{}, {}, {}]", lo[0], lo[1], lo[2],
                                                hi[0], hi[1], hi[2]);
     const int a_pos = l.add(positions, 5126, "VEC3", out.vertices, 34962, pos_bounds);
@@ -192,26 +159,7 @@ GeneratedSkin write_generated_skin(const std::filesystem::path& path, const Gene
         join(samplers, ",\n  "), join(channels, ",\n  "), join(l.accessors, ",\n  "), join(l.views, ",\n  "),
         l.bin.size());
 
-    // GLB: header, JSON chunk padded with spaces, BIN chunk padded with zeros (glTF 2.0 section 4.4).
-    std::string json_chunk = json;
-    json_chunk.resize((json_chunk.size() + 3) & ~size_t(3), ' ');
-    const size_t total = 12 + 8 + json_chunk.size() + 8 + l.bin.size();
-    if (total > 0xFFFFFFFFu) throw Error(fmt::format("generated skin: {} bytes do not fit a GLB", total));
-    std::string head;
-    head += "glTF";
-    put_u32(head, 2);
-    put_u32(head, uint32_t(total));
-    put_u32(head, uint32_t(json_chunk.size()));
-    head += "JSON";
-    std::string bin_head;
-    put_u32(bin_head, uint32_t(l.bin.size()));
-    bin_head += std::string("BIN\0", 4);
-    std::ofstream f(path, std::ios::binary);
-    f.write(head.data(), std::streamsize(head.size()));
-    f.write(json_chunk.data(), std::streamsize(json_chunk.size()));
-    f.write(bin_head.data(), std::streamsize(bin_head.size()));
-    f.write(reinterpret_cast<const char*>(l.bin.data()), std::streamsize(l.bin.size()));
-    if (!f) throw Error(fmt::format("generated skin: cannot write {}", path.string()));
+    const size_t total = write_glb(path, json, l.bin, "generated skin");
     out.bytes = total;
     return out;
 }

@@ -25,10 +25,11 @@ int main(int argc, char** argv) {
     bench->require_subcommand(1);
     bench->fallthrough();
     // Each benchmark module registers itself here (one line each; benchmarks/bench_commands.h):
-    std::vector<app::Command> commands{app::register_bench_aa(*bench),      app::register_bench_accel(*bench),
-                                       app::register_bench_anim(*bench),    app::register_bench_env(*bench),
-                                       app::register_bench_process(*bench), app::register_bench_scale(*bench),
-                                       app::register_bench_skip(*bench),    app::register_bench_stability(*bench)};
+    std::vector<app::Command> commands{app::register_bench_aa(*bench),        app::register_bench_accel(*bench),
+                                       app::register_bench_anim(*bench),      app::register_bench_env(*bench),
+                                       app::register_bench_materials(*bench), app::register_bench_process(*bench),
+                                       app::register_bench_scale(*bench),     app::register_bench_skip(*bench),
+                                       app::register_bench_stability(*bench)};
     for (app::Command& c : commands) c.app->fallthrough();
     try {
         app.parse(argc, argv);

@@ -15,6 +15,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <numbers>
@@ -59,6 +60,7 @@ namespace {
 using namespace gltf;
 
 constexpr size_t kMaxJsonDepth = 64;  ///< array/object nesting (docs/fuzzing.md)
+constexpr double kNoLimit = std::numeric_limits<double>::infinity();  ///< an unbounded factor
 
 // ---------------------------------------------------------------------------------------------
 // Reading the file
@@ -754,6 +756,10 @@ private:
                            const std::string& ptr) {
         TextureRef ref;
         if (index < 0) return ref;
+        // validate_gltf() resolved every slot; this keeps texture_index() in bounds on its own.
+        if (size_t(index) >= m_model.textures.size())
+            fail(ptr + "/index", "unresolved reference: texture {} does not exist (the file has {})", index,
+                 m_model.textures.size());
         ref.scale = float(scale);
         int uv = tex_coord;
         if (const tinygltf::Value* xf = find_extension(extensions, "KHR_texture_transform")) {
@@ -779,16 +785,67 @@ private:
         return ref;
     }
 
-    /// A textureInfo kept as raw JSON by tinygltf (inside material extensions).
-    TextureRef texture_ref_value(const tinygltf::Value* info, bool srgb, const std::string& ptr) {
+    /// A textureInfo kept as raw JSON by tinygltf (inside material extensions); `with_scale` reads
+    /// a normalTextureInfo's "scale" into TextureRef::scale.
+    TextureRef texture_ref_value(const tinygltf::Value* info, bool srgb, const std::string& ptr,
+                                 bool with_scale = false) {
         if (info == nullptr) return {};
         int index = -1, tex_coord = 0;
-        as_int(find_member(info, "index"), index);
+        if (!as_int(find_member(info, "index"), index) || index < 0)
+            fail(ptr + "/index", "textureInfo index must be a non-negative integer");
         as_int(find_member(info, "texCoord"), tex_coord);
         tinygltf::ExtensionMap exts;
         if (const tinygltf::Value* xf = find_member(find_member(info, "extensions"), "KHR_texture_transform"))
             exts["KHR_texture_transform"] = *xf;
-        return texture_ref(index, tex_coord, 1.0, exts, srgb, ptr);
+        const double scale = with_scale ? factor(info, "scale", 1.f, ptr) : 1.0;
+        return texture_ref(index, tex_coord, scale, exts, srgb, ptr);
+    }
+
+    /// Reads the number (out.size() == 1) or array of out.size() numbers `key` of a material
+    /// extension into `out`, which holds the defaults and is left alone when `key` is absent. Not a
+    /// finite number is an error; a component outside [lo, hi] is clamped, with one warning for the
+    /// (material, field).
+    void read_factors(const tinygltf::Value* ext, const char* key, std::span<float> out, const std::string& ptr,
+                      double lo, double hi) {
+        const tinygltf::Value* v = find_member(ext, key);
+        if (v == nullptr) return;
+        const std::string at = ptr + "/" + key;
+        if (out.size() == 1 && !v->IsNumber()) fail(at, "{} is not a number", key);
+        if (out.size() > 1 && (!v->IsArray() || v->ArrayLen() != out.size()))
+            fail(at, "{} must be an array of {} numbers", key, out.size());
+        std::string given, clamped;
+        bool clamps = false;
+        for (size_t k = 0; k < out.size(); ++k) {
+            const tinygltf::Value* e = out.size() == 1 ? v : find_element(v, k);
+            const std::string elem_at = out.size() == 1 ? at : fmt::format("{}/{}", at, k);
+            if (!e->IsNumber()) fail(elem_at, "not a number");
+            const double d = e->GetNumberAsDouble();
+            const double c = std::clamp(d, lo, hi);
+            if (!std::isfinite(d) || !std::isfinite(float(c))) fail(elem_at, "{} {} is not a finite number", key, d);
+            clamps |= c != d;
+            given += fmt::format("{}{}", k ? ", " : "", d);
+            clamped += fmt::format("{}{}", k ? ", " : "", c);
+            out[k] = float(c);
+        }
+        if (!clamps) return;
+        if (out.size() > 1) given = "(" + given + ")", clamped = "(" + clamped + ")";
+        m_warnings.add("factor-clamped:" + at,
+                       fmt::format("{}: {} outside [{}, {}], clamped to {}", at, given, lo, hi, clamped));
+    }
+
+    /// A scalar factor of a material extension (read_factors), `fallback` when absent.
+    float factor(const tinygltf::Value* ext, const char* key, float fallback, const std::string& ptr,
+                 double lo = -kNoLimit, double hi = kNoLimit) {
+        float v = fallback;
+        read_factors(ext, key, std::span<float>(&v, 1), ptr, lo, hi);
+        return v;
+    }
+
+    /// An RGB factor of a material extension with components in [0, 1] (read_factors).
+    Color color_factor(const tinygltf::Value* ext, const char* key, Color fallback, const std::string& ptr) {
+        float c[3] = {fallback.x, fallback.y, fallback.z};
+        read_factors(ext, key, c, ptr, 0.0, 1.0);
+        return {c[0], c[1], c[2]};
     }
 
     void convert_materials() {
@@ -800,16 +857,24 @@ private:
             const auto& pbr = g.pbrMetallicRoughness;
             Material m;
             m.name = g.name.empty() ? fmt::format("material {}", i) : g.name;
-            m.base_color = {float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2]),
-                            float(pbr.baseColorFactor[3])};
-            m.metallic = float(pbr.metallicFactor);
-            m.roughness = float(pbr.roughnessFactor);
-            m.base_color_texture =
-                texture_ref(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, 1.0,
-                            pbr.baseColorTexture.extensions, true, ptr + "/pbrMetallicRoughness/baseColorTexture");
-            m.metallic_roughness_texture = texture_ref(
-                pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, 1.0,
-                pbr.metallicRoughnessTexture.extensions, false, ptr + "/pbrMetallicRoughness/metallicRoughnessTexture");
+            const std::string eptr = ptr + "/extensions/";
+            // A file giving specular-glossiness asks for it; its pbrMetallicRoughness is the
+            // fallback for viewers without the extension (the extension's "Best practices").
+            if (const tinygltf::Value* e = find_extension(g.extensions, "KHR_materials_pbrSpecularGlossiness")) {
+                convert_specular_glossiness(e, eptr + "KHR_materials_pbrSpecularGlossiness", m);
+            } else {
+                m.base_color = {float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]),
+                                float(pbr.baseColorFactor[2]), float(pbr.baseColorFactor[3])};
+                m.metallic = float(pbr.metallicFactor);
+                m.roughness = float(pbr.roughnessFactor);
+                m.base_color_texture =
+                    texture_ref(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, 1.0,
+                                pbr.baseColorTexture.extensions, true, ptr + "/pbrMetallicRoughness/baseColorTexture");
+                m.metallic_roughness_texture =
+                    texture_ref(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, 1.0,
+                                pbr.metallicRoughnessTexture.extensions, false,
+                                ptr + "/pbrMetallicRoughness/metallicRoughnessTexture");
+            }
             m.normal_texture = texture_ref(g.normalTexture.index, g.normalTexture.texCoord, g.normalTexture.scale,
                                            g.normalTexture.extensions, false, ptr + "/normalTexture");
             m.occlusion_texture =
@@ -824,7 +889,6 @@ private:
             m.alpha_cutoff = float(g.alphaCutoff);
             m.double_sided = g.doubleSided;
 
-            const std::string eptr = ptr + "/extensions/";
             if (const tinygltf::Value* e = find_extension(g.extensions, "KHR_materials_emissive_strength"))
                 m.emissive_strength =
                     float(number(e, "emissiveStrength", 1.0, eptr + "KHR_materials_emissive_strength"));
@@ -859,8 +923,94 @@ private:
                 m.specular_color_texture =
                     texture_ref_value(find_member(e, "specularColorTexture"), true, p + "/specularColorTexture");
             }
+            convert_layers(g.extensions, eptr, m);
             m_scene.materials.push_back(std::move(m));
         }
+    }
+
+    /// The layered extensions (clearcoat, sheen, iridescence, anisotropy, dispersion, diffuse
+    /// transmission) into `m`; absent ones keep scene.h's defaults, which switch the layer off.
+    /// Channels and transfer functions are the extensions' own (their READMEs' property tables).
+    void convert_layers(const tinygltf::ExtensionMap& extensions, const std::string& eptr, Material& m) {
+        if (const tinygltf::Value* e = find_extension(extensions, "KHR_materials_clearcoat")) {
+            const std::string p = eptr + "KHR_materials_clearcoat";
+            m.clearcoat = factor(e, "clearcoatFactor", 0.f, p, 0.0, 1.0);
+            m.clearcoat_texture = texture_ref_value(find_member(e, "clearcoatTexture"), false, p + "/clearcoatTexture");
+            m.clearcoat_roughness = factor(e, "clearcoatRoughnessFactor", 0.f, p, 0.0, 1.0);
+            m.clearcoat_roughness_texture =
+                texture_ref_value(find_member(e, "clearcoatRoughnessTexture"), false, p + "/clearcoatRoughnessTexture");
+            m.clearcoat_normal_texture = texture_ref_value(find_member(e, "clearcoatNormalTexture"), false,
+                                                           p + "/clearcoatNormalTexture", true);
+        }
+        if (const tinygltf::Value* e = find_extension(extensions, "KHR_materials_sheen")) {
+            const std::string p = eptr + "KHR_materials_sheen";
+            m.sheen_color = color_factor(e, "sheenColorFactor", Color(0.f), p);
+            m.sheen_color_texture =
+                texture_ref_value(find_member(e, "sheenColorTexture"), true, p + "/sheenColorTexture");
+            m.sheen_roughness = factor(e, "sheenRoughnessFactor", 0.f, p, 0.0, 1.0);
+            m.sheen_roughness_texture =
+                texture_ref_value(find_member(e, "sheenRoughnessTexture"), false, p + "/sheenRoughnessTexture");
+        }
+        if (const tinygltf::Value* e = find_extension(extensions, "KHR_materials_iridescence")) {
+            const std::string p = eptr + "KHR_materials_iridescence";
+            m.iridescence = factor(e, "iridescenceFactor", 0.f, p, 0.0, 1.0);
+            m.iridescence_texture =
+                texture_ref_value(find_member(e, "iridescenceTexture"), false, p + "/iridescenceTexture");
+            m.iridescence_ior = factor(e, "iridescenceIor", 1.3f, p);
+            if (!(m.iridescence_ior > 0.f))
+                fail(p + "/iridescenceIor", "iridescenceIor {} must be positive", m.iridescence_ior);
+            m.iridescence_thickness_min = factor(e, "iridescenceThicknessMinimum", 100.f, p);
+            m.iridescence_thickness_max = factor(e, "iridescenceThicknessMaximum", 400.f, p);
+            // The minimum may exceed the maximum (the extension allows it): mix(min, max, g) then
+            // runs from thick to thin, so both are kept as given.
+            if (m.iridescence_thickness_min < 0.f)
+                fail(p + "/iridescenceThicknessMinimum", "iridescenceThicknessMinimum {} nm is negative",
+                     m.iridescence_thickness_min);
+            if (m.iridescence_thickness_max < 0.f)
+                fail(p + "/iridescenceThicknessMaximum", "iridescenceThicknessMaximum {} nm is negative",
+                     m.iridescence_thickness_max);
+            m.iridescence_thickness_texture = texture_ref_value(find_member(e, "iridescenceThicknessTexture"), false,
+                                                                p + "/iridescenceThicknessTexture");
+        }
+        if (const tinygltf::Value* e = find_extension(extensions, "KHR_materials_anisotropy")) {
+            const std::string p = eptr + "KHR_materials_anisotropy";
+            m.anisotropy_strength = factor(e, "anisotropyStrength", 0.f, p, 0.0, 1.0);
+            m.anisotropy_rotation = factor(e, "anisotropyRotation", 0.f, p);
+            m.anisotropy_texture =
+                texture_ref_value(find_member(e, "anisotropyTexture"), false, p + "/anisotropyTexture");
+        }
+        if (const tinygltf::Value* e = find_extension(extensions, "KHR_materials_dispersion")) {
+            const std::string p = eptr + "KHR_materials_dispersion";
+            m.dispersion = factor(e, "dispersion", 0.f, p);
+            if (m.dispersion < 0.f)
+                fail(p + "/dispersion", "dispersion {} is negative (it is 20 / Abbe number, 0 = none)", m.dispersion);
+        }
+        if (const tinygltf::Value* e = find_extension(extensions, "KHR_materials_diffuse_transmission")) {
+            const std::string p = eptr + "KHR_materials_diffuse_transmission";
+            m.diffuse_transmission = factor(e, "diffuseTransmissionFactor", 0.f, p, 0.0, 1.0);
+            m.diffuse_transmission_texture = texture_ref_value(find_member(e, "diffuseTransmissionTexture"), false,
+                                                               p + "/diffuseTransmissionTexture");
+            m.diffuse_transmission_color = color_factor(e, "diffuseTransmissionColorFactor", Color(1.f), p);
+            m.diffuse_transmission_color_texture = texture_ref_value(find_member(e, "diffuseTransmissionColorTexture"),
+                                                                     true, p + "/diffuseTransmissionColorTexture");
+        }
+    }
+
+    /// KHR_materials_pbrSpecularGlossiness into `m`, with the core fields set to their nearest
+    /// metallic-roughness reading (metallic 0, roughness 1 - glossiness) for code that reads only those.
+    void convert_specular_glossiness(const tinygltf::Value* e, const std::string& p, Material& m) {
+        m.specular_glossiness = true;
+        float diffuse[4] = {1.f, 1.f, 1.f, 1.f};
+        read_factors(e, "diffuseFactor", diffuse, p, 0.0, 1.0);
+        m.base_color = {diffuse[0], diffuse[1], diffuse[2], diffuse[3]};
+        // Both textures are sRGB-encoded in RGB; Texture::srgb leaves alpha (coverage, glossiness) linear.
+        m.base_color_texture = texture_ref_value(find_member(e, "diffuseTexture"), true, p + "/diffuseTexture");
+        m.sg_specular = color_factor(e, "specularFactor", Color(1.f), p);
+        m.glossiness = factor(e, "glossinessFactor", 1.f, p, 0.0, 1.0);
+        m.specular_glossiness_texture =
+            texture_ref_value(find_member(e, "specularGlossinessTexture"), true, p + "/specularGlossinessTexture");
+        m.metallic = 0.f;
+        m.roughness = 1.f - m.glossiness;
     }
 
     uint32_t default_material() {
@@ -1072,8 +1222,31 @@ private:
     }
 
     // ---- memory budget ------------------------------------------------------------------------
-    bool needs_tangents(const tinygltf::Primitive& p) const {
-        return p.material >= 0 && m_scene.materials[size_t(p.material)].normal_texture.valid();
+    /// Why a primitive needs a tangent frame, and the UV set tangents are generated from when the
+    /// file gives none (uv -1: no need).
+    struct TangentNeed {
+        int uv = -1;
+        const char* reason = "";  ///< for the warning when the primitive lacks that UV set
+        const char* effect = "";
+    };
+
+    /// A normal texture, anisotropy (strength > 0) and an active clearcoat's normal texture each
+    /// need the tangent frame; the normal texture's UV set wins (the extensions ask theirs to be
+    /// the same), then the anisotropy texture's, then the clearcoat normal texture's, else 0.
+    TangentNeed tangent_need(const tinygltf::Primitive& p) const {
+        if (p.material < 0) return {};
+        const Material& m = m_scene.materials[size_t(p.material)];
+        if (m.normal_texture.valid())
+            return {int(m.normal_texture.uv_set), "the normal texture uses", "normal map has no effect"};
+        const bool anisotropic = m.anisotropy_strength > 0.f;
+        const bool coat_normal = m.clearcoat > 0.f && m.clearcoat_normal_texture.valid();
+        if (anisotropic && m.anisotropy_texture.valid())
+            return {int(m.anisotropy_texture.uv_set), "the anisotropy texture uses", "anisotropy has no direction"};
+        if (coat_normal)
+            return {int(m.clearcoat_normal_texture.uv_set), "the clearcoat normal texture uses",
+                    "clearcoat normal map has no effect"};
+        if (anisotropic) return {0, "anisotropy takes its tangents from", "anisotropy has no direction"};
+        return {};
     }
 
     void check_memory() const {
@@ -1085,7 +1258,7 @@ private:
             const tinygltf::Primitive& p = m_model.meshes[size_t(k.mesh)].primitives[size_t(k.primitive)];
             const size_t verts = m_model.accessors[size_t(p.attributes.at("POSITION"))].count;
             size_t per_vertex = 2 * sizeof(Vec3f);  // positions, normals
-            if (p.attributes.count("TANGENT") || needs_tangents(p)) per_vertex += sizeof(Vec4f);
+            if (p.attributes.count("TANGENT") || tangent_need(p).uv >= 0) per_vertex += sizeof(Vec4f);
             if (p.attributes.count("TEXCOORD_0")) per_vertex += sizeof(Vec2f);
             if (p.attributes.count("TEXCOORD_1")) per_vertex += sizeof(Vec2f);
             if (p.attributes.count("COLOR_0")) per_vertex += sizeof(Vec4f);
@@ -1187,9 +1360,9 @@ private:
             });
         }
 
-        // Tangents: read when present, generated from the normal texture's UV set when needed.
-        const int tangent_uv =
-            needs_tangents(p) ? int(m_scene.materials[size_t(p.material)].normal_texture.uv_set) : -1;
+        // Tangents: read when present, generated when the material needs them (tangent_need).
+        const TangentNeed need = tangent_need(p);
+        const int tangent_uv = need.uv;
         if (auto it = p.attributes.find("TANGENT"); it != p.attributes.end()) {
             mesh.tangents.resize(nv);
             bool any_bad = false;
@@ -1209,9 +1382,9 @@ private:
         } else if (tangent_uv >= 0) {
             const std::vector<Vec2f>& uv = tangent_uv == 0 ? mesh.uv0 : mesh.uv1;
             if (uv.empty())
-                warnings.add("normal-map-no-uv", fmt::format("{}: the normal texture uses TEXCOORD_{}, which the "
-                                                               "primitive lacks: no tangents, normal map has no effect",
-                                                               ptr, tangent_uv));
+                warnings.add(std::string("tangent-no-uv:") + need.reason,
+                             fmt::format("{}: {} TEXCOORD_{}, which the primitive lacks: no tangents, {}", ptr,
+                                         need.reason, tangent_uv, need.effect));
             else
                 mesh.tangents = generate_tangents(mesh, uv);
         }
@@ -1280,8 +1453,7 @@ private:
         std::vector<uint32_t> unique;     // requests that decode, in order
         for (size_t i = 0; i < n; ++i) {
             const tinygltf::Primitive& p = primitive(m_requests[i]);
-            const int tangent_uv =
-                needs_tangents(p) ? int(m_scene.materials[size_t(p.material)].normal_texture.uv_set) : -1;
+            const int tangent_uv = tangent_need(p).uv;
             if (m_requests[i].node >= 0) {  // deformed by its node's pose: geometry of its own
                 source[i] = uint32_t(i);
                 unique.push_back(uint32_t(i));

@@ -1093,10 +1093,7 @@ private:
             m_scene.instances.push_back(std::move(in));
         }
         for (Material& m : inc.materials) {
-            for (TextureRef* r : {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture,
-                                  &m.occlusion_texture, &m.emissive_texture, &m.transmission_texture, &m.specular_texture,
-                                  &m.specular_color_texture, &m.classic_color_texture})
-                shift(*r, tex_offset);
+            for (TextureRef* r : m.texture_slots()) shift(*r, tex_offset);
             m_scene.materials.push_back(std::move(m));
         }
         for (Texture& t : inc.textures) m_scene.textures.push_back(std::move(t));

@@ -101,6 +101,44 @@ std::string texture_slot(const char* slot, const TextureRef& ref, bool show_scal
     return s + ")";
 }
 
+/// The active glTF material extensions of `m` and their factors ("clearcoat=1 roughness=0.1;
+/// sheen color=(...) roughness=0.5"), each extension's textures after its factors; "" when none.
+std::string material_extensions(const Material& m) {
+    std::vector<std::string> parts;
+    if (m.clearcoat > 0.f)
+        parts.push_back(fmt::format("clearcoat={} roughness={}", num(m.clearcoat), num(m.clearcoat_roughness)) +
+                        texture_slot("texture", m.clearcoat_texture, false) +
+                        texture_slot("roughness_texture", m.clearcoat_roughness_texture, false) +
+                        texture_slot("normal_texture", m.clearcoat_normal_texture, true));
+    if (m.sheen_color != Color(0.f))
+        parts.push_back(fmt::format("sheen color={} roughness={}", vec3(m.sheen_color), num(m.sheen_roughness)) +
+                        texture_slot("color_texture", m.sheen_color_texture, false) +
+                        texture_slot("roughness_texture", m.sheen_roughness_texture, false));
+    if (m.iridescence > 0.f)
+        parts.push_back(fmt::format("iridescence={} ior={} thickness={}..{}nm", num(m.iridescence),
+                                    num(m.iridescence_ior), num(m.iridescence_thickness_min),
+                                    num(m.iridescence_thickness_max)) +
+                        texture_slot("texture", m.iridescence_texture, false) +
+                        texture_slot("thickness_texture", m.iridescence_thickness_texture, false));
+    if (m.anisotropy_strength > 0.f)
+        parts.push_back(fmt::format("anisotropy={} rotation={}", num(m.anisotropy_strength),
+                                    num(m.anisotropy_rotation)) +
+                        texture_slot("texture", m.anisotropy_texture, false));
+    if (m.dispersion > 0.f) parts.push_back(fmt::format("dispersion={}", num(m.dispersion)));
+    if (m.diffuse_transmission > 0.f)
+        parts.push_back(fmt::format("diffuse_transmission={} color={}", num(m.diffuse_transmission),
+                                    vec3(m.diffuse_transmission_color)) +
+                        texture_slot("texture", m.diffuse_transmission_texture, false) +
+                        texture_slot("color_texture", m.diffuse_transmission_color_texture, false));
+    if (m.specular_glossiness)
+        parts.push_back(fmt::format("specular-glossiness specular={} glossiness={}", vec3(m.sg_specular),
+                                    num(m.glossiness)) +
+                        texture_slot("texture", m.specular_glossiness_texture, false));
+    std::string out;
+    for (const std::string& p : parts) out += (out.empty() ? "" : "; ") + p;
+    return out;
+}
+
 /// " width=640 aa=adaptive ..." for the settings a scene file set, "" when none.
 std::string render_settings(const SceneRenderSettings& s) {
     std::string out;
@@ -300,6 +338,8 @@ std::string describe_scene(const Scene& scene, ReportDetail detail) {
                                 texture_slot("specular_color", m.specular_color_texture, false) +
                                 texture_slot("classic_color", m.classic_color_texture, false);
         line(fmt::format("material[{}] textures:{}", i, tex.empty() ? " none" : tex));
+        if (const std::string ext = material_extensions(m); !ext.empty())
+            line(fmt::format("material[{}] extensions: {}", i, ext));
     }
 
     for (size_t i = 0; i < scene.textures.size(); ++i) {

@@ -11,6 +11,9 @@ KernelFeatures select_kernel(const SceneFeatures& scene, const IntegratorSetting
     k.attributes = scene.varying;
     k.transmission = !scene.opaque();
     k.mirror = scene.mirror || k.transmission;  // total internal reflection turns kt into kr
+    // Layered materials: per-hit evaluation with the texture frame, and the coat's mirror rays.
+    k.layers = scene.layered;
+    if (k.layers) k.attributes = k.mirror = true;
     return k;
 }
 
@@ -21,6 +24,7 @@ std::string kernel_name(const KernelFeatures& k) {
     s += k.mirror ? (k.transmission ? " reflection+refraction," : " reflection only,") : " no recursion,";
     s += k.attributes ? " textures/vertex colors" : " constant materials (no UVs)";
     if (k.tables) s += ", light culling";
+    if (k.layers) s += ", layered materials";
     return s;
 }
 

@@ -17,6 +17,7 @@ struct KernelFeatures {
                                ///< glossy term kg G casts no ray and is in every kernel
     bool transmission = true;  ///< refraction, alpha blend, absorption, shadow transmittance products
     bool tables = false;       ///< constant materials from a table, per-object light lists
+    bool layers = true;        ///< the layered material extensions (shading/layered_model.h), per material
     constexpr bool operator==(const KernelFeatures&) const = default;
 };
 
@@ -26,9 +27,10 @@ constexpr KernelFeatures kGeneralKernel{};
 /// Every kernel select_kernel can return, and the general one: the instantiations compiled.
 constexpr KernelFeatures kKernels[] = {
     kGeneralKernel,
-    {false, false, false, true}, {true, false, false, true},  // opaque, no recursion
-    {false, true, false, true},  {true, true, false, true},   // opaque mirrors
-    {false, true, true, true},   {true, true, true, true},    // glass (and mirrors)
+    {false, false, false, true, false}, {true, false, false, true, false},  // opaque, no recursion
+    {false, true, false, true, false},  {true, true, false, true, false},   // opaque mirrors
+    {false, true, true, true, false},   {true, true, true, true, false},    // glass (and mirrors)
+    {true, true, false, true, true},    {true, true, true, true, true},     // layered materials
 };
 
 /// The smallest kernel that renders a scene with these features exactly like the general one.

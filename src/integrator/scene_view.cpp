@@ -229,18 +229,32 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
         Vec3f n = normalize(xf_normal(xf.n, interpolate(mesh.normals, i0, i1, i2, u, v)));
         if (n != Vec3f(0.f) && is_finite(n)) ns = n;
     }
+    sp.nc = ns;
     const Material& mat = m_scene.materials[mesh.material];
-    if (kAttributes && mat.normal_texture.valid() && !mesh.tangents.empty() && mat.model == MaterialModel::GltfPbr) {
+    const bool layered = mat.model == MaterialModel::GltfPbr && mat.layered();
+    if (kAttributes && !mesh.tangents.empty() && mat.model == MaterialModel::GltfPbr &&
+        (mat.normal_texture.valid() || layered)) {
+        // The texture-space frame: the tangent Gram-Schmidt'ed against the interpolated normal.
         Vec4f t4 = interpolate(mesh.tangents, i0, i1, i2, u, v);
         Vec3f t = xf_vector(xf.m, t4.xyz());
-        t = normalize(t - ns * dot(ns, t));  // Gram-Schmidt against the shading normal
-        if (t != Vec3f(0.f)) {
-            Vec3f b = cross(ns, t) * (t4.w < 0.f ? -1.f : 1.f);
-            Vec4f tex = lookup(m_scene, mat.normal_texture, sp.uv, sp.uv_lod);
-            float s = mat.normal_texture.scale;
-            Vec3f m{(tex.x * 2.f - 1.f) * s, (tex.y * 2.f - 1.f) * s, tex.z * 2.f - 1.f};
-            Vec3f mapped = normalize(t * m.x + b * m.y + ns * m.z);
-            if (mapped != Vec3f(0.f) && is_finite(mapped)) ns = mapped;
+        t = normalize(t - ns * dot(ns, t));
+        if (t != Vec3f(0.f) && is_finite(t)) {
+            const Vec3f b = cross(ns, t) * (t4.w < 0.f ? -1.f : 1.f);
+            auto mapped_normal = [&](const TextureRef& ref) {
+                const Vec4f tex = lookup(m_scene, ref, sp.uv, sp.uv_lod);
+                const float s = ref.scale;
+                const Vec3f m{(tex.x * 2.f - 1.f) * s, (tex.y * 2.f - 1.f) * s, tex.z * 2.f - 1.f};
+                const Vec3f mapped = normalize(t * m.x + b * m.y + ns * m.z);
+                return mapped != Vec3f(0.f) && is_finite(mapped) ? mapped : ns;
+            };
+            if (layered) {
+                // KHR_materials_clearcoat's own normal map over the interpolated normal;
+                // KHR_materials_anisotropy's direction lives in this frame.
+                if (mat.clearcoat_normal_texture.valid()) sp.nc = mapped_normal(mat.clearcoat_normal_texture);
+                sp.tangent = t;
+                sp.bitangent = b;
+            }
+            if (mat.normal_texture.valid()) ns = mapped_normal(mat.normal_texture);
         }
     }
     sp.ns = ns;
@@ -265,7 +279,7 @@ SurfacePoint SceneView::sphere_surface(const Ray& ray, const Hit& hit, const Ray
     // its t error near the surface is a few ulps of r, whatever |c| (a large sphere grazing the
     // world origin has hit points much smaller than r).
     sp.offset_scale = float(sphere.radius);
-    sp.ng = sp.ns = normalize(Vec3f(n));
+    sp.ng = sp.ns = sp.nc = normalize(Vec3f(n));
     if constexpr (!kAttributes) return sp;
     const bool uvs = m_needs_uv[sphere.material] != 0;
     if (uvs) {
@@ -304,7 +318,7 @@ SurfacePoint SceneView::plane_surface(const Ray& ray, const Hit& hit, const RayC
     // of max|point|, stays below a quarter of the 4-ulp float offset of 2^-26 max|point|, so only a
     // plane defined by a point ~1e8 times farther out than the hit moves the unit.
     sp.offset_scale = float(max_abs(plane.point)) * 0x1p-26f;
-    sp.ng = sp.ns = Vec3f(plane.normal);
+    sp.ng = sp.ns = sp.nc = Vec3f(plane.normal);
     if constexpr (!kAttributes) return sp;
     const bool uvs = m_needs_uv[plane.material] != 0;
     if (uvs) {
@@ -341,7 +355,44 @@ PbrSample SceneView::material_inputs(const Material& m, const SurfacePoint& sp) 
     s.emissive = m.emissive * em.xyz() * m.emissive_strength;
     s.specular = m.specular * lookup(m_scene, m.specular_texture, sp.uv, sp.uv_lod).w;
     s.specular_color = m.specular_color * lookup(m_scene, m.specular_color_texture, sp.uv, sp.uv_lod).xyz();
+    if (m.specular_glossiness)
+        apply_specular_glossiness(m, lookup(m_scene, m.specular_glossiness_texture, sp.uv, sp.uv_lod), s);
+    if (m.layered()) layer_inputs(m, sp, s);
     return s;
+}
+
+void SceneView::layer_inputs(const Material& m, const SurfacePoint& sp, PbrSample& s) const {
+    auto channel = [&](const TextureRef& ref, int c) { return lookup(m_scene, ref, sp.uv, sp.uv_lod)[c]; };
+    s.clearcoat = m.clearcoat * channel(m.clearcoat_texture, 0);
+    s.clearcoat_roughness = m.clearcoat_roughness * channel(m.clearcoat_roughness_texture, 1);
+    s.sheen_color = m.sheen_color * lookup(m_scene, m.sheen_color_texture, sp.uv, sp.uv_lod).xyz();
+    s.sheen_roughness = m.sheen_roughness * channel(m.sheen_roughness_texture, 3);
+    s.iridescence = m.iridescence * channel(m.iridescence_texture, 0);
+    // Without a thickness texture the film is iridescenceThicknessMaximum thick (texel 1).
+    const float g = channel(m.iridescence_thickness_texture, 1);
+    s.iridescence_thickness = m.iridescence_thickness_min + (m.iridescence_thickness_max - m.iridescence_thickness_min) * g;
+    // KHR_materials_anisotropy: the texture's direction (RG from [0, 1] to [-1, 1], (1, 0) without
+    // one) rotated by anisotropyRotation; its B channel scales the strength.
+    const float cos_r = std::cos(m.anisotropy_rotation), sin_r = std::sin(m.anisotropy_rotation);
+    Vec2f d{1.f, 0.f};
+    float strength = m.anisotropy_strength;
+    if (m.anisotropy_texture.valid()) {
+        const Vec4f a = lookup(m_scene, m.anisotropy_texture, sp.uv, sp.uv_lod);
+        const Vec2f t{a.x * 2.f - 1.f, a.y * 2.f - 1.f};
+        const float len = std::sqrt(t.x * t.x + t.y * t.y);
+        if (len > 0.f) d = {t.x / len, t.y / len};
+        strength *= a.z;
+    }
+    s.anisotropy = strength;
+    s.anisotropy_direction = {cos_r * d.x - sin_r * d.y, sin_r * d.x + cos_r * d.y};
+    s.diffuse_transmission = m.diffuse_transmission * channel(m.diffuse_transmission_texture, 3);
+    s.diffuse_transmission_color =
+        m.diffuse_transmission_color * lookup(m_scene, m.diffuse_transmission_color_texture, sp.uv, sp.uv_lod).xyz();
+}
+
+WhittedCoeffs SceneView::layered_coefficients(const SurfacePoint& sp, const LayerFrame& f, LayerCoeffs& layers) const {
+    const Material& m = m_scene.materials[sp.material];
+    return map_layered(m, material_inputs(m, sp), f, m_mapping, layers);
 }
 
 WhittedCoeffs SceneView::coefficients(const SurfacePoint& sp) const {

@@ -11,6 +11,7 @@
 #include "accel/accelerator.h"
 #include "scene/scene.h"
 #include "shading/environment_map.h"
+#include "shading/layered_model.h"
 #include "shading/light_sample.h"
 #include "shading/material_mapping.h"
 #include "shading/scene_analysis.h"
@@ -39,6 +40,9 @@ struct SurfacePoint {
                                 ///< planes: 2^-26 max|point| (see SceneView::surface)
     Vec3f ng;                   ///< unit geometric normal (front side by winding)
     Vec3f ns;                   ///< unit shading normal (interpolated, normal-mapped), front side
+    Vec3f nc;                   ///< unit clearcoat normal (interpolated, clearcoat-normal-mapped), front side
+    Vec3f tangent, bitangent;   ///< texture-space frame about the interpolated normal, only for layered
+                                ///< materials on meshes with tangents (zero otherwise)
     Vec2f uv[2];                ///< TEXCOORD_0/1 (0 when absent)
     Vec4f color{1.f, 1.f, 1.f, 1.f};  ///< COLOR_0 (1 when absent)
     uint32_t material = 0;
@@ -73,6 +77,8 @@ public:
     PbrSample material_inputs(const Material& material, const SurfacePoint& sp) const;
     /// Whitted's (1980) coefficients at a point.
     WhittedCoeffs coefficients(const SurfacePoint& sp) const;
+    /// A layered material's base coefficients and layers at a point seen in frame `f` (map_layered).
+    WhittedCoeffs layered_coefficients(const SurfacePoint& sp, const LayerFrame& f, LayerCoeffs& layers) const;
     const Scene& scene() const { return m_scene; }
     const MappingOptions& mapping() const { return m_mapping; }
     /// What the scene uses, analysed with this view's mapping options.
@@ -99,6 +105,8 @@ public:
 private:
     /// Everything the view holds, from the scene (the environment map when missing or stale).
     void derive();
+    /// The layered extensions' inputs at a point (factors x texture channels) into `s`.
+    void layer_inputs(const Material& m, const SurfacePoint& sp, PbrSample& s) const;
     /// Coverage alpha at a hit (base color alpha x texture x vertex alpha), UV0/UV1 interpolated.
     float alpha_at(const Material& m, const Hit& hit) const;
     Vec3f world_geometric_normal(const Hit& hit) const;

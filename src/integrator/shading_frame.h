@@ -26,6 +26,14 @@ inline ShadingFrame shading_frame(const SurfacePoint& sp, const Vec3f& dir) {
     return f;
 }
 
+/// The directions the layered material extensions read (layered_model.h), on the viewer's side:
+/// the coat normal turned like N, and N itself where it would face away.
+inline LayerFrame layer_frame(const SurfacePoint& sp, const ShadingFrame& f) {
+    LayerFrame l{f.V, f.N, f.front ? sp.nc : -sp.nc, sp.tangent, sp.bitangent};
+    if (dot(l.Nc, f.V) <= 0.f) l.Nc = f.N;
+    return l;
+}
+
 /// A secondary ray from sp along unit `dir`, its origin moved to the side `side` points to (+Ng:
 /// the viewer's side, -Ng: through the surface) by the accelerator's offset policy.
 inline Ray spawn_ray(const RayOffsetPolicy& offset, const SurfacePoint& sp, const Vec3f& side, const Vec3f& dir) {

@@ -53,27 +53,52 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
         if (const std::optional<Hit> cover = covering_surface(hit, sp, counters))
             return shade<K>(ray, *cover, depth, counters, primary, cone, weight);
     }
+    const ShadingFrame frame = shading_frame(sp, ray.dir);
     WhittedCoeffs varying;
-    const WhittedCoeffs& c = coefficients<K>(mf, sp, varying);
-    const Shading s{ray, hit, sp, c, m_view.scene().materials[sp.material], mf, shading_frame(sp, ray.dir),
+    LayerCoeffs layers;
+    const LayerCoeffs* layered = nullptr;
+    const WhittedCoeffs* coeffs;
+    if constexpr (K.layers) {
+        if (mf.layered) {
+            varying = m_view.layered_coefficients(sp, layer_frame(sp, frame), layers);
+            layered = &layers;
+            coeffs = &varying;
+        } else {
+            coeffs = &coefficients<K>(mf, sp, varying);
+        }
+    } else {
+        coeffs = &coefficients<K>(mf, sp, varying);
+    }
+    const WhittedCoeffs& c = *coeffs;
+    const Shading s{ray, hit, sp, c, m_view.scene().materials[sp.material], mf, frame,
                     touching_medium<K>(hit, sp, c, counters), depth, RayCone{cone.width_at(hit.t), cone.spread},
-                    weight};
+                    weight, layered};
     if (primary) *primary = first_hit(hit, s.f.N, c);
 
     Color I = c.emission;
     const bool unlit = s.mat.model == MaterialModel::GltfPbr && s.mat.unlit;  // KHR_materials_unlit
     if (!unlit) {
         // I = emission + Ia ka + sum_i Is_i fat_i s_i (kd N.L_i + ks (N.H_i)^n) + kt T + kr R + kg G
-        I = direct_light<K>(I + ambient_light(s) * c.ka, s, counters);
+        Color ambient = ambient_light(s.f.N) * c.ka;
+        if constexpr (K.layers)
+            if (layered) ambient += layered_ambient(s);
+        I = direct_light<K>(I + ambient, s, counters);
         if (depth < m_settings.max_depth) {
             Color kt_T(0.f), kr_R(0.f);
             if constexpr (K.mirror || K.transmission) {
                 auto [kr, kt] = secondary_weights(c.ks, c.kr, c.kt, std::clamp(dot(s.f.N, s.f.V), 0.f, 1.f),
                                                   m_settings.fresnel);
                 kt_T = transmitted<K>(s, kt, kr, counters);  // total internal reflection adds kt to kr
-                kr_R = reflected<K>(s, kr, counters);
+                Color coat_R(0.f);
+                if constexpr (K.layers)
+                    if (layered) coat_R = coat_reflection<K>(s, kr, counters);  // may join the base's ray
+                kr_R = reflected<K>(s, kr, s.f.N, counters);
+                if (layered) kr_R += coat_R;
             }
-            const Color kg_G = glossy(s, counters);  // in every kernel: rough opaque scenes cast no mirror rays
+            // In every kernel: rough opaque scenes cast no mirror rays.
+            Color kg_G = glossy(s, c.kg, layered ? layers.glossy_normal : s.f.N, c.roughness, c.n, counters);
+            if (layered && layers.coat_kg > 0.f)
+                kg_G += glossy(s, Color(layers.coat_kg), layers.Nc, layers.coat_roughness, layers.coat_n, counters);
             I = I + kt_T + kr_R + kg_G;
         }
     }
@@ -89,8 +114,16 @@ Color WhittedIntegrator::missed(const Ray& ray, int depth, const RayCone& cone) 
     return m_settings.background;
 }
 
-Color WhittedIntegrator::ambient_light(const Shading& s) const {
-    return m_ambient_sh ? sh9_irradiance(*m_ambient_sh, s.f.N) : m_settings.ambient;
+Color WhittedIntegrator::ambient_light(const Vec3f& N) const {
+    return m_ambient_sh ? sh9_irradiance(*m_ambient_sh, N) : m_settings.ambient;
+}
+
+Color WhittedIntegrator::layered_ambient(const Shading& s) const {
+    const LayerCoeffs& l = *s.layers;
+    Color a(0.f);
+    if (!is_black(l.sheen_ambient)) a += ambient_light(s.f.N) * l.sheen_ambient;
+    if (!is_black(l.kdt)) a += ambient_light(-s.f.N) * l.kdt;  // diffuse transmission: from behind
+    return a;
 }
 
 // ---- Direct light: sum_i Is_i fat_i s_i (kd N.L_i + ks (N.H_i)^n) --------------------------
@@ -109,19 +142,22 @@ Color WhittedIntegrator::ambient_light(const Shading& s) const {
 template <KernelFeatures K>
 Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& counters) const {
     const WhittedCoeffs& c = s.c;
-    if (is_black(c.kd) && is_black(c.ks)) return sum;
+    if (is_black(c.kd) && is_black(c.ks) && !s.layers) return sum;
     std::optional<Vec3f> shadow_org;  // computed at the first light that needs a shadow ray
+    std::optional<Vec3f> back_org;    // diffuse transmission: lights behind the surface
     struct Candidate {
         const Light* light;
         LightSample ls;
         Color potential;  // Is fat (kd N.L + ks (N.H)^n): the light's term if nothing shadows it
         float key;
+        bool behind;      // seen through the surface (diffuse transmission)
     };
     thread_local std::vector<Candidate> environment;
     environment.clear();
     auto shadowed = [&](const Candidate& e) {
         if (!shadow_org) shadow_org = m_offset.origin(s.f.front ? s.sp.p_shadow : s.sp.p, s.sp.offset_scale, s.f.Ng);
-        const Color shadow = shadow_factor(*e.light, e.ls, *shadow_org, counters);
+        if (e.behind && !back_org) back_org = m_offset.origin(s.sp.p, s.sp.offset_scale, -s.f.Ng);
+        const Color shadow = shadow_factor(*e.light, e.ls, e.behind ? *back_org : *shadow_org, counters);
         if (is_black(shadow)) return Color(0.f);
         // Opaque scenes: the shadow factor is exactly 1 here, and x * 1 == x.
         if constexpr (K.transmission) return e.potential * shadow;
@@ -137,18 +173,27 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
             ++counters.shadow_skipped_unreached;
             return;
         }
-        // Light only where N.L > 0 on the shading normal; the shadow ray decides the rest.
+        // Light only where N.L > 0 on the shading normal (or behind a diffusely transmitting
+        // layered surface); the shadow ray decides the rest.
         const float n_dot_l = dot(s.f.N, ls.L);
-        if (n_dot_l <= 0.f) {
+        bool behind = false;
+        if constexpr (K.layers) behind = s.layers && n_dot_l < 0.f && !is_black(s.layers->kdt);
+        if (n_dot_l <= 0.f && !behind) {
             ++counters.shadow_skipped_facing;
             return;
         }
-        const Color term = local_term(c, s.f.N, ls.L, s.f.V, n_dot_l, light.from_environment ? environment_scale : 1.f);
+        Color term;
+        if constexpr (K.layers) {
+            term = s.layers ? layered_term(c, *s.layers, s.f.N, ls.L, s.f.V, n_dot_l, light.from_environment)
+                            : local_term(c, s.f.N, ls.L, s.f.V, n_dot_l, light.from_environment ? environment_scale : 1.f);
+        } else {
+            term = local_term(c, s.f.N, ls.L, s.f.V, n_dot_l, light.from_environment ? environment_scale : 1.f);
+        }
         if (is_black(term)) {  // kd = 0 and the highlight below its cutoff
             ++counters.shadow_skipped_zero;
             return;
         }
-        Candidate e{&light, ls, ls.intensity * term, 0.f};
+        Candidate e{&light, ls, ls.intensity * term, 0.f, behind};
         if (!light.from_environment) {
             sum += shadowed(e);
             return;
@@ -237,13 +282,19 @@ Color WhittedIntegrator::transmitted(const Shading& s, const Color& kt, Color& k
     if (is_black(kt) || !worth_tracing(w, counters)) return Color(0.f);
     Ray t = spawn_ray(m_offset, s.sp, -s.f.Ng, s.ray.dir);
     float eta = s.f.front ? 1.f / s.c.ior : s.c.ior;
+    float other_eta = 1.f;
     if (s.other) {
         // One interface between the two media (no total internal reflection in a gap of zero
         // width), and the ray starts past both surfaces.
-        eta *= s.f.front ? s.other->c.ior : 1.f / s.other->c.ior;
+        other_eta = s.f.front ? s.other->c.ior : 1.f / s.other->c.ior;
+        eta *= other_eta;
         const Vec3f past_other =
             m_offset.origin(s.other->p, std::max(s.sp.offset_scale, s.other->offset_scale), -s.f.Ng);
         if (dot(past_other - t.org, s.f.Ng) < 0.f) t.org = past_other;
+    }
+    if constexpr (K.layers) {
+        if (s.layers && s.layers->dispersion > 0.f && !s.c.thin)
+            return dispersed<K>(s, t, kt, kt_through, other_eta, w, kr, counters);
     }
     const std::optional<Vec3f> dir = transmitted_direction(s.ray.dir, s.f.N, s.f.Ng, eta, s.c.thin);
     if (!dir) {
@@ -254,13 +305,66 @@ Color WhittedIntegrator::transmitted(const Shading& s, const Color& kt, Color& k
     return kt_through * trace<K>(t, RayKind::Refraction, s.depth + 1, counters, nullptr, s.secondary, w);
 }
 
+/// The colour channel the current refracted ray carries after a dispersive surface split it
+/// (-1: all three). Set around each channel's trace on this thread, so the surfaces below bend
+/// that ray by the channel's own index of refraction instead of splitting it again.
+static thread_local int t_dispersion_channel = -1;
+
+/// kt T through a dispersive surface (KHR_materials_dispersion): one refracted ray per channel,
+/// each bent by that channel's ior (dispersion_iors) and keeping that channel of its radiance; a
+/// ray already carrying one channel stays one ray. Total internal reflection of a channel adds
+/// its kt to kr. `other_eta`: the touching medium's factor of the relative index.
+template <KernelFeatures K>
+Color WhittedIntegrator::dispersed(const Shading& s, const Ray& t, const Color& kt, const Color& kt_through,
+                                   float other_eta, float w, Color& kr, RayCounters& counters) const {
+    const Color iors = dispersion_iors(s.c.ior, s.layers->dispersion);
+    auto bent = [&](int k) {
+        const float eta = (s.f.front ? 1.f / iors[k] : iors[k]) * other_eta;
+        return transmitted_direction(s.ray.dir, s.f.N, s.f.Ng, eta, false);
+    };
+    struct Channel {  // sets the thread's channel for one trace, and restores it
+        explicit Channel(int k) { t_dispersion_channel = k; }
+        ~Channel() { t_dispersion_channel = -1; }
+    };
+    Color result(0.f);
+    const int carried = t_dispersion_channel;
+    for (int k = 0; k < 3; ++k) {
+        if (carried >= 0 && k != carried) continue;
+        if (!(kt[k] > 0.f)) continue;
+        const std::optional<Vec3f> dir = bent(k);
+        if (!dir) {
+            kr[k] += kt[k];
+            continue;
+        }
+        Ray tk = t;
+        tk.dir = *dir;
+        if (carried >= 0) return kt_through * trace<K>(tk, RayKind::Refraction, s.depth + 1, counters, nullptr, s.secondary, w);
+        const Channel channel(k);
+        result[k] = kt_through[k] * trace<K>(tk, RayKind::Refraction, s.depth + 1, counters, nullptr, s.secondary, w)[k];
+    }
+    return result;
+}
+
 /// kr R: the radiance of the mirror ray weighted by kr.
 template <KernelFeatures K>
-Color WhittedIntegrator::reflected(const Shading& s, const Color& kr, RayCounters& counters) const {
+Color WhittedIntegrator::reflected(const Shading& s, const Color& kr, const Vec3f& N, RayCounters& counters) const {
     const float w = s.weight * max_component(kr);
     if (is_black(kr) || !worth_tracing(w, counters)) return Color(0.f);
-    const Ray r = spawn_ray(m_offset, s.sp, s.f.Ng, mirror_direction(s.f.V, s.f.N, s.f.Ng));
+    const Ray r = spawn_ray(m_offset, s.sp, s.f.Ng, mirror_direction(s.f.V, N, s.f.Ng));
     return kr * trace<K>(r, RayKind::Reflection, s.depth + 1, counters, nullptr, s.secondary, w);
+}
+
+/// The clearcoat's mirror ray: where the coat's normal is the base's, one ray carries both
+/// weights (added to kr); else its own ray about the coat's normal.
+template <KernelFeatures K>
+Color WhittedIntegrator::coat_reflection(const Shading& s, Color& kr, RayCounters& counters) const {
+    const LayerCoeffs& l = *s.layers;
+    if (!(l.coat_kr > 0.f)) return Color(0.f);
+    if (l.Nc == s.f.N) {
+        kr += Color(l.coat_kr);
+        return Color(0.f);
+    }
+    return reflected<K>(s, Color(l.coat_kr), l.Nc, counters);
 }
 
 // ---- Glossy reflection of the environment: kg G ----------------------------------------------
@@ -269,13 +373,14 @@ Color WhittedIntegrator::reflected(const Shading& s, const Color& kr, RayCounter
 /// mirror term gives up on rough surfaces. The lights extracted from the map already reflect
 /// highlight_share(n) of their light as highlights, so that share of the extracted part is read
 /// from the residual instead of the map. It sees the environment only, never the scene's geometry.
-Color WhittedIntegrator::glossy(const Shading& s, RayCounters& counters) const {
-    if (!m_environment || is_black(s.c.kg)) return Color(0.f);
-    if (!worth_tracing(s.weight * max_component(s.c.kg), counters)) return Color(0.f);
-    const Vec3f R = mirror_direction(s.f.V, s.f.N, s.f.Ng);
-    const Color G = m_environment->prefiltered(R, s.c.roughness);
-    if (!m_environment->has_residual()) return s.c.kg * G;
-    return s.c.kg * lerp(G, m_environment->residual_prefiltered(R, s.c.roughness), highlight_share(s.c.n));
+Color WhittedIntegrator::glossy(const Shading& s, const Color& kg, const Vec3f& N, float roughness, float n,
+                                RayCounters& counters) const {
+    if (!m_environment || is_black(kg)) return Color(0.f);
+    if (!worth_tracing(s.weight * max_component(kg), counters)) return Color(0.f);
+    const Vec3f R = mirror_direction(s.f.V, N, s.f.Ng);
+    const Color G = m_environment->prefiltered(R, roughness);
+    if (!m_environment->has_residual()) return kg * G;
+    return kg * lerp(G, m_environment->residual_prefiltered(R, roughness), highlight_share(n));
 }
 
 // ---- Media and coverage: absorption, alpha blend ------------------------------------------------

@@ -94,6 +94,7 @@ private:
         const int depth;
         const RayCone secondary;                 ///< footprint the secondary rays start with
         const float weight;                      ///< path weight of the ray that hit
+        const LayerCoeffs* layers;               ///< a layered material's layers (c is their base); null otherwise
     };
 
     template <KernelFeatures K>
@@ -112,16 +113,27 @@ private:
     /// background (no environment, or a camera ray when the environment is not visible).
     Color missed(const Ray& ray, int depth, const RayCone& cone) const;
     /// Ia at the hit: the environment's ambient light in the direction of N, or the constant.
-    Color ambient_light(const Shading& s) const;
+    Color ambient_light(const Vec3f& N) const;
+    /// The layers' ambient terms: the sheen lobe's albedo and diffuse transmission from behind.
+    Color layered_ambient(const Shading& s) const;
     template <KernelFeatures K>
     Color direct_light(Color sum, const Shading& s, RayCounters& counters) const;
     template <KernelFeatures K>
     Color transmitted(const Shading& s, const Color& kt, Color& kr, RayCounters& counters) const;
+    /// kr R about the shading normal N (the coat's normal for a clearcoat's own ray).
     template <KernelFeatures K>
-    Color reflected(const Shading& s, const Color& kr, RayCounters& counters) const;
-    /// kg G: the environment prefiltered by the roughness about the mirror direction (0 without
-    /// an environment); no ray is traced, so it sees no geometry.
-    Color glossy(const Shading& s, RayCounters& counters) const;
+    Color reflected(const Shading& s, const Color& kr, const Vec3f& N, RayCounters& counters) const;
+    /// The coat's mirror ray (one ray with the base's when their normals agree) and glossy term.
+    template <KernelFeatures K>
+    Color coat_reflection(const Shading& s, Color& kr, RayCounters& counters) const;
+    /// kg G: the environment prefiltered by `roughness` about V mirrored on N (0 without an
+    /// environment); no ray is traced, so it sees no geometry. n: the lobe's highlight exponent.
+    Color glossy(const Shading& s, const Color& kg, const Vec3f& N, float roughness, float n,
+                 RayCounters& counters) const;
+    /// kt T split per channel through a dispersive surface (KHR_materials_dispersion).
+    template <KernelFeatures K>
+    Color dispersed(const Shading& s, const Ray& t, const Color& kt, const Color& kt_through, float other_eta, float w,
+                    Color& kr, RayCounters& counters) const;
     Color absorbed(const Shading& s, Color radiance) const;
     /// s_i: the light's visibility from the shadow-ray origin (transmittance through transparent occluders).
     Color shadow_factor(const Light& light, const LightSample& ls, const Vec3f& org, RayCounters& counters) const;

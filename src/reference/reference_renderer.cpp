@@ -394,6 +394,7 @@ private:
         p.emissive = m.emissive * texture(m.emissive_texture, s.uv, s).xyz() * m.emissive_strength;
         p.specular = m.specular * texture(m.specular_texture, s.uv, s).w;
         p.specular_color = m.specular_color * texture(m.specular_color_texture, s.uv, s).xyz();
+        if (m.specular_glossiness) apply_specular_glossiness(m, texture(m.specular_glossiness_texture, s.uv, s), p);
         return p;
     }
 

@@ -6,6 +6,7 @@
 // uses it becomes one Instance per primitive.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -205,9 +206,71 @@ struct Material {
     TextureRef specular_texture;               ///< A channel
     TextureRef specular_color_texture;         ///< RGB, sRGB-encoded
 
+    // The layered extensions (docs/materials.md, "Layers"). Defaults switch each layer off.
+    // KHR_materials_clearcoat: a dielectric coat (ior 1.5) over everything below.
+    float clearcoat = 0.f;                     ///< clearcoatFactor
+    TextureRef clearcoat_texture;              ///< R channel
+    float clearcoat_roughness = 0.f;           ///< clearcoatRoughnessFactor
+    TextureRef clearcoat_roughness_texture;    ///< G channel
+    TextureRef clearcoat_normal_texture;       ///< scale = clearcoatNormalTexture.scale
+    // KHR_materials_sheen: the Charlie lobe over the base (sheen color 0 = no sheen).
+    Color sheen_color{0.f};                    ///< sheenColorFactor (linear)
+    TextureRef sheen_color_texture;            ///< RGB, sRGB-encoded
+    float sheen_roughness = 0.f;               ///< sheenRoughnessFactor
+    TextureRef sheen_roughness_texture;        ///< A channel
+    // KHR_materials_iridescence: a thin film replacing the Fresnel of the specular lobe.
+    float iridescence = 0.f;                   ///< iridescenceFactor
+    TextureRef iridescence_texture;            ///< R channel
+    float iridescence_ior = 1.3f;              ///< iridescenceIor (of the film)
+    float iridescence_thickness_min = 100.f;   ///< nm, texture value 0
+    float iridescence_thickness_max = 400.f;   ///< nm, texture value 1 (and without a texture)
+    TextureRef iridescence_thickness_texture;  ///< G channel
+    // KHR_materials_anisotropy: an anisotropic highlight along a tangent-space direction.
+    float anisotropy_strength = 0.f;           ///< [0, 1]
+    float anisotropy_rotation = 0.f;           ///< radians, counter-clockwise from the tangent
+    TextureRef anisotropy_texture;             ///< RG: direction in [-1, 1] (from [0, 1]), B: strength
+    // KHR_materials_dispersion
+    float dispersion = 0.f;                    ///< 20 / Abbe number; 0 = one ior for every channel
+    // KHR_materials_diffuse_transmission: a diffuse BTDF sharing the diffuse lobe's weight.
+    float diffuse_transmission = 0.f;          ///< diffuseTransmissionFactor
+    TextureRef diffuse_transmission_texture;   ///< A channel
+    Color diffuse_transmission_color{1.f};     ///< diffuseTransmissionColorFactor (linear)
+    TextureRef diffuse_transmission_color_texture;  ///< RGB, sRGB-encoded
+    // KHR_materials_pbrSpecularGlossiness: diffuseFactor/diffuseTexture are read into
+    // base_color/base_color_texture, metallic is 0, roughness 1 - glossiness, F0 = specular.
+    bool specular_glossiness = false;
+    Color sg_specular{1.f};                    ///< specularFactor (linear)
+    float glossiness = 1.f;                    ///< glossinessFactor
+    TextureRef specular_glossiness_texture;    ///< RGB specular (sRGB-encoded), A glossiness (linear)
+
+    /// True when one of the layered extensions above is active (clearcoat, sheen, iridescence,
+    /// anisotropy, dispersion, diffuse transmission); specular-glossiness is not a layer.
+    bool layered() const {
+        return clearcoat > 0.f || sheen_color != Color(0.f) || iridescence > 0.f || anisotropy_strength > 0.f ||
+               dispersion > 0.f || diffuse_transmission > 0.f;
+    }
+
     // MaterialModel::Classic: Whitted's (1980) coefficients, used as given.
     WhittedCoeffs classic;
     TextureRef classic_color_texture;          ///< Classic: RGB multiplies kd and ka (checker or image)
+
+private:
+    template <class M>
+    static auto slots(M& m) {
+        return std::array{&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture,
+                          &m.occlusion_texture, &m.emissive_texture, &m.transmission_texture,
+                          &m.specular_texture, &m.specular_color_texture, &m.clearcoat_texture,
+                          &m.clearcoat_roughness_texture, &m.clearcoat_normal_texture, &m.sheen_color_texture,
+                          &m.sheen_roughness_texture, &m.iridescence_texture, &m.iridescence_thickness_texture,
+                          &m.anisotropy_texture, &m.diffuse_transmission_texture,
+                          &m.diffuse_transmission_color_texture, &m.specular_glossiness_texture,
+                          &m.classic_color_texture};
+    }
+
+public:
+    /// Every texture slot, for code that treats them alike (analysis, scene-file includes).
+    auto texture_slots() { return slots(*this); }
+    auto texture_slots() const { return slots(*this); }
 };
 
 // ---------------------------------------------------------------------------------------------

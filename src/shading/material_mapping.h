@@ -30,8 +30,21 @@ struct PbrSample {
     float occlusion = 1.f;                 ///< 1 + strength * (occlusionTexture.r - 1); 1 = unoccluded
     Color emissive{0.f};                   ///< final linear emission: emissiveFactor * emissiveTexture.rgb * emissive_strength
     float specular = 1.f;                  ///< KHR_materials_specular specularFactor * specularTexture.a
-    Color specular_color{1.f};             ///< specularColorFactor * specularColorTexture.rgb (linear, may exceed 1)
+    Color specular_color{1.f};             ///< specularColorFactor * specularColorTexture.rgb (linear, may exceed 1);
+                                           ///< specular-glossiness: specularFactor * texture.rgb, used as F0
+    // The layered extensions (0 = off), factor x texture channel (docs/materials.md, "Layers").
+    float clearcoat = 0.f;                 ///< clearcoatFactor * clearcoatTexture.r
+    float clearcoat_roughness = 0.f;       ///< clearcoatRoughnessFactor * clearcoatRoughnessTexture.g
+    Color sheen_color{0.f};                ///< sheenColorFactor * sheenColorTexture.rgb
+    float sheen_roughness = 0.f;           ///< sheenRoughnessFactor * sheenRoughnessTexture.a
+    float iridescence = 0.f;               ///< iridescenceFactor * iridescenceTexture.r
+    float iridescence_thickness = 0.f;     ///< nm: mix(minimum, maximum, thicknessTexture.g), maximum without a texture
+    float anisotropy = 0.f;                ///< anisotropyStrength * anisotropyTexture.b
+    Vec2f anisotropy_direction{1.f, 0.f};  ///< unit direction in (tangent, bitangent), rotation applied
+    float diffuse_transmission = 0.f;      ///< diffuseTransmissionFactor * texture.a
+    Color diffuse_transmission_color{1.f}; ///< diffuseTransmissionColorFactor * texture.rgb
 };
+
 
 /// Maps the glTF inputs at a point to Whitted's coefficients (m = metallic, t = transmission,
 /// r = roughness; F0d = dielectric F0 per KHR_materials_specular; max() = largest channel):
@@ -48,8 +61,34 @@ struct PbrSample {
 /// and every other coefficient 0; MaterialModel::Classic returns material.classic unchanged.
 WhittedCoeffs map_gltf_material(const Material& material, const PbrSample& sample, const MappingOptions& options);
 
+/// The base layer of a layered material seen at N.V = cos_v: map_gltf_material plus what the
+/// layered extensions change in it. KHR_materials_iridescence: F0 (dielectric and metal) becomes
+/// mix(F0, iridescence_fresnel(cos_v, iridescence_ior, thickness, F0), iridescence).
+/// KHR_materials_anisotropy: the mirror fade uses the wider roughness sqrt(alpha_t), the glossy
+/// term the roughness sqrt(sqrt(alpha_t alpha_b)). KHR_materials_diffuse_transmission (in both
+/// mappings): kd keeps (1 - dt) of the diffuse lobe, and `kdt` receives the transmitted share,
+/// diffuseTransmissionColor (1 - m)(1 - t)(1 - max F0d) dt.
+WhittedCoeffs map_layered_base(const Material& material, const PbrSample& sample, const MappingOptions& options,
+                               float cos_v, Color& kdt);
+
+/// Anisotropic GGX widths of KHR_materials_anisotropy: alpha_t = mix(alpha, 1, strength^2) along the
+/// anisotropy direction, alpha_b = alpha across it, alpha = roughness^2.
+struct AnisotropicAlpha {
+    float t, b;
+};
+AnisotropicAlpha anisotropic_alpha(float roughness, float strength);
+
+/// The highlight exponent n = 2/alpha^2 - 2 of a GGX/Beckmann width alpha (floored at 1e-3),
+/// clamped to [1, max_exponent] (Walter et al. 2007).
+float highlight_exponent(float alpha, float max_exponent);
+
 /// The coefficients of a material without any texture or vertex color (for `whitted info`).
 WhittedCoeffs map_material_constant(const Material& material, const MappingOptions& options);
+
+/// KHR_materials_pbrSpecularGlossiness at a point: metallic 0, F0 = specularFactor x texel.rgb (as
+/// specular_color with specular 1), roughness = 1 - glossinessFactor x texel.a; the diffuse colour
+/// is the base colour, already read. `texel`: the specularGlossinessTexture's (1 without one).
+void apply_specular_glossiness(const Material& material, const Vec4f& texel, PbrSample& sample);
 
 /// The PbrSample built from a material's factors alone (textures and vertex colors ignored).
 PbrSample constant_pbr_sample(const Material& material);

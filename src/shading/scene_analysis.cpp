@@ -11,9 +11,7 @@ namespace whitted {
 namespace {
 
 bool any_texture(const Material& m) {
-    for (const TextureRef* r : {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture,
-                                &m.occlusion_texture, &m.emissive_texture, &m.transmission_texture,
-                                &m.specular_texture, &m.specular_color_texture, &m.classic_color_texture})
+    for (const TextureRef* r : m.texture_slots())
         if (r->valid()) return true;
     return false;
 }
@@ -61,6 +59,12 @@ MaterialFeatures material_features(const Material& m, const MappingOptions& mapp
     f.mirror = smooth_enough && (!is_black(f.constant.ks) || f.textured);
     f.emissive = !is_black(m.emissive) && m.emissive_strength > 0.f;
     f.volume = f.transmission && m.has_volume && m.thickness > 0.f && !is_black(f.constant.absorption);
+    if (m.layered()) {
+        // Evaluated per hit and view (layered_model.h); a coat reflects whatever the base does.
+        f.layered = true;
+        f.highlight = f.mirror = true;
+        f.diffuse |= m.diffuse_transmission > 0.f;
+    }
     return f;
 }
 
@@ -70,9 +74,17 @@ MaterialFeatures material_features(const Material& m, const MappingOptions& mapp
 uint32_t glossy_levels(const Material& m, const MaterialFeatures& f) {
     if (m.model == MaterialModel::Classic)
         return is_black(f.constant.kg) ? 0u : prefilter_levels_read(f.constant.roughness, f.constant.roughness);
-    if (m.unlit || (is_black(f.constant.kg) && !f.textured)) return 0u;
+    if (m.unlit || (is_black(f.constant.kg) && !f.textured && !f.layered)) return 0u;
     const float r = std::clamp(m.roughness, 0.f, 1.f);
-    return prefilter_levels_read(m.metallic_roughness_texture.valid() ? 0.f : r, r);
+    const float lo = m.metallic_roughness_texture.valid() ? 0.f : r;
+    // Anisotropy reads sqrt(sqrt(alpha_t alpha_b)) in [r, sqrt(r)] (alpha_t <= 1, alpha_b = r^2).
+    uint32_t levels = prefilter_levels_read(lo, m.anisotropy_strength > 0.f ? std::sqrt(r) : r);
+    if (m.clearcoat > 0.f) {
+        // The coat's glossy term: clearcoat roughness = factor x texture <= factor.
+        const float rc = std::clamp(m.clearcoat_roughness, 0.f, 1.f);
+        levels |= prefilter_levels_read(m.clearcoat_roughness_texture.valid() ? 0.f : rc, rc);
+    }
+    return levels;
 }
 
 /// Smallest distance from p to the box b (0 inside).
@@ -184,7 +196,7 @@ SceneAnalysis analyze_scene(const Scene& scene, const MappingOptions& mapping) {
     // Per material: varying = evaluated per hit; the OR over the used ones.
     SceneFeatures& s = a.features;
     for (MaterialFeatures& f : a.materials) {
-        f.varying = f.textured || f.vertex_colors;
+        f.varying = f.textured || f.vertex_colors || f.layered;
         if (f.used) s |= f;
     }
     for (size_t i = 0; i < a.materials.size(); ++i)

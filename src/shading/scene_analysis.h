@@ -37,6 +37,7 @@ struct FeatureFlags {
     bool alpha_blend = false;     ///< alpha BLEND: rays behind, partial shadows
     bool volume = false;          ///< Beer-Lambert absorption inside (KHR_materials_volume)
     bool single_sided = false;    ///< back faces culled for camera rays (filters in traversal)
+    bool layered = false;         ///< a layered extension (clearcoat, sheen, ...): the layered kernel
     /// Coefficients depend on the point (textures or vertex colors): evaluated per hit. Otherwise
     /// MaterialFeatures::constant holds them for every point.
     bool varying = false;
@@ -54,6 +55,7 @@ struct FeatureFlags {
         alpha_blend |= o.alpha_blend;
         volume |= o.volume;
         single_sided |= o.single_sided;
+        layered |= o.layered;
         varying |= o.varying;
         return *this;
     }

@@ -133,7 +133,9 @@ INSTANTIATE_TEST_SUITE_P(
                       "gltf/BoxVertexColors/glTF-Binary/BoxVertexColors.glb", "gltf/UnlitTest/glTF-Binary/UnlitTest.glb",
                       "gltf/EmissiveStrengthTest/glTF-Binary/EmissiveStrengthTest.glb",
                       "gltf/TextureSettingsTest/glTF-Binary/TextureSettingsTest.glb",
-                      "gltf/NegativeScaleTest/glTF-Binary/NegativeScaleTest.glb"),
+                      "gltf/NegativeScaleTest/glTF-Binary/NegativeScaleTest.glb",
+                      "gltf/ClearCoatTest/glTF-Binary/ClearCoatTest.glb",
+                      "gltf/AnisotropyRotationTest/glTF-Binary/AnisotropyRotationTest.glb"),
     [](const ::testing::TestParamInfo<std::string>& info) {
         std::string name = info.param.substr(info.param.rfind('/') + 1);
         name = name.substr(0, name.find('.'));

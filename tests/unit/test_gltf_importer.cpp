@@ -800,14 +800,14 @@ TEST(GltfHandMade, RequiredExtensions) {
         "soft_ext.gltf",
         edit(
             kQuadJson, R"("asset": {"version": "2.0"},)",
-            R"("asset": {"version": "2.0"}, "extensionsUsed": ["KHR_materials_clearcoat", "EXT_foo", "KHR_materials_sheen"], "extensionsRequired": ["KHR_materials_sheen"],)"),
+            R"("asset": {"version": "2.0"}, "extensionsUsed": ["KHR_materials_volume_scatter", "EXT_foo", "KHR_xmp_json_ld"], "extensionsRequired": ["KHR_xmp_json_ld"],)"),
         quad_bin());
     const Scene s = load_scene(soft);
     ASSERT_EQ(s.extensions.size(), 3u);
     EXPECT_EQ(s.extensions[0].support, ExtensionSupport::Ignored);
     EXPECT_EQ(s.extensions[1].note, "unknown extension");
     EXPECT_TRUE(s.extensions[2].required);
-    EXPECT_EQ(warnings_containing(s, "extension KHR_materials_clearcoat ignored"), 1u);
+    EXPECT_EQ(warnings_containing(s, "extension KHR_materials_volume_scatter ignored"), 1u);
     EXPECT_EQ(warnings_containing(s, "extension EXT_foo ignored"), 1u);
 }
 
