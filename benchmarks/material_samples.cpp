@@ -132,9 +132,9 @@ std::string sphere_material(const std::string& extension, int k) {
     }
     if (extension == "iridescence")
         return fmt::format("{{{}, {}, \"extensions\": {{\"KHR_materials_iridescence\": {{\"iridescenceFactor\": 1, "
-                           "\"iridescenceIor\": 1.3, \"iridescenceThicknessMinimum\": 100, "
+                           "\"iridescenceIor\": 1.8, \"iridescenceThicknessMinimum\": 100, "
                            "\"iridescenceThicknessMaximum\": {}}}}}}}",
-                           name, pbr(0.9, 0.9, 0.9, 1.0, 0.25), float(100.0 + 700.0 * t));
+                           name, pbr(0.02, 0.02, 0.02, 0.0, 0.15), float(200.0 + 600.0 * t));
     if (extension == "anisotropy")
         return fmt::format("{{{}, {}, \"extensions\": {{\"KHR_materials_anisotropy\": {{\"anisotropyStrength\": {}, "
                            "\"anisotropyRotation\": 0}}}}}}",

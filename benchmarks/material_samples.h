@@ -7,7 +7,7 @@
 // Sphere k (0..4, left to right) uses the extension at strength t = k / 4:
 //   clearcoat             red rough base, clearcoatFactor 0.2..1, clearcoatRoughness 0
 //   sheen                 dark blue rough base, sheenColor (0.2..1) x (1, 0.6, 0.8), sheenRoughness 0.2..1
-//   iridescence           silver metal (roughness 0.25), iridescenceFactor 1, thickness 100..800 nm
+//   iridescence           black dielectric (roughness 0.15), iridescenceFactor 1, film ior 1.8, thickness 200..800 nm
 //   anisotropy            metal (roughness 0.4), anisotropyStrength 0.2..1 along the tangent
 //   dispersion            glass: transmission 1, KHR_materials_volume thickness 1, ior 1.5, dispersion 0.5..4
 //   diffuse_transmission  warm rough base, diffuseTransmissionFactor 0.25..1; the light comes from behind

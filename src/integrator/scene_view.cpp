@@ -86,6 +86,18 @@ void SceneView::derive() {
     if (scene.environment && (!m_environment || levels != m_analysis.prefilter_levels))
         m_environment = std::make_shared<const EnvironmentMap>(*scene.environment, 0, EnvironmentMap::Use::Rendering,
                                                                m_analysis.prefilter_levels);
+    // What a shadow ray keeps crossing a glTF material that is the same everywhere (no texture,
+    // no vertex colour): computed once here instead of at every crossing.
+    m_constant_shadow_kt.assign(scene.materials.size(), std::nullopt);
+    for (size_t i = 0; i < scene.materials.size(); ++i) {
+        const Material& m = scene.materials[i];
+        const MaterialFeatures& f = m_analysis.materials[i];
+        if (m.model == MaterialModel::GltfPbr && !f.textured && !f.vertex_colors) {
+            SurfacePoint sp;
+            sp.material = uint32_t(i);
+            m_constant_shadow_kt[i] = transmitted_light(m, sp);
+        }
+    }
     m_directional_samples.assign(scene.lights.size(), LightSample{});
     for (size_t i = 0; i < scene.lights.size(); ++i)
         if (scene.lights[i].type == LightType::Directional)
@@ -127,7 +139,8 @@ void SceneView::derive() {
         if (cutout || single_sided) f |= kNeedsAccept;
         const bool transmissive = m.model == MaterialModel::Classic ? !is_black(m.classic.kt)
                                                                     : (m.transmission > 0.f || m.transmission_texture.valid() ||
-                                                                       m.alpha_mode == AlphaMode::Blend);
+                                                                       m.alpha_mode == AlphaMode::Blend ||
+                                                                       m.diffuse_transmission > 0.f);
         if (cutout || transmissive) f |= kNeedsTransmittance;
         m_mesh_flags[g] = f;
     }
@@ -410,6 +423,21 @@ WhittedCoeffs SceneView::coefficients(const SurfacePoint& sp) const {
     return map_gltf_material(m, material_inputs(m, sp), m_mapping);
 }
 
+Color SceneView::shadow_kt(const Material& m, const Ray& ray, const Hit& hit) const {
+    const std::optional<Color>& constant = m_constant_shadow_kt[m_scene.geom_material(hit.geom)];
+    return constant ? *constant : transmitted_light(m, surface(ray, hit));
+}
+
+Color SceneView::transmitted_light(const Material& m, const SurfacePoint& sp) const {
+    const PbrSample s = material_inputs(m, sp);
+    if (!(m.diffuse_transmission > 0.f)) return map_gltf_material(m, s, m_mapping).kt;
+    // KHR_materials_diffuse_transmission: what the surface lets through diffusely also reaches
+    // the far side of a shadow ray, as a filter (its direction is not followed).
+    Color kdt;
+    const WhittedCoeffs c = map_layered_base(m, s, m_mapping, 1.f, kdt);
+    return c.kt + kdt;
+}
+
 float SceneView::alpha_at(const Material& m, const Hit& hit) const {
     const Mesh& mesh = m_scene.meshes[hit.geom];
     const uint32_t i0 = mesh.indices[size_t(hit.prim) * 3 + 0];
@@ -439,8 +467,7 @@ Color SceneView::transmittance(const Ray& ray, const Hit& hit) const {
     if (m.model == MaterialModel::Classic) return m.classic.kt;
     if (m_scene.geom_kind(hit.geom) != GeomKind::Mesh) {
         // glTF material on an analytic primitive: Kt at the point (no alpha coverage).
-        const SurfacePoint sp = surface(ray, hit);
-        return map_gltf_material(m, material_inputs(m, sp), m_mapping).kt;
+        return shadow_kt(m, ray, hit);
     }
     float coverage = 1.f;
     if (m.alpha_mode == AlphaMode::Mask) {
@@ -449,10 +476,7 @@ Color SceneView::transmittance(const Ray& ray, const Hit& hit) const {
         coverage = alpha_at(m, hit);
     }
     Color kt(0.f);
-    if (m.transmission > 0.f) {
-        SurfacePoint sp = surface(ray, hit);
-        kt = map_gltf_material(m, material_inputs(m, sp), m_mapping).kt;
-    }
+    if (m.transmission > 0.f || m.diffuse_transmission > 0.f) kt = shadow_kt(m, ray, hit);
     // BLEND: the uncovered fraction passes untouched, the covered part passes through Kt.
     return Color(1.f - coverage) + kt * coverage;
 }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -105,6 +106,10 @@ public:
 private:
     /// Everything the view holds, from the scene (the environment map when missing or stale).
     void derive();
+    /// What a shadow ray crossing a glTF surface at sp keeps: kt, plus the diffuse transmission's kdt.
+    Color transmitted_light(const Material& m, const SurfacePoint& sp) const;
+    /// transmitted_light at a shadow ray's crossing, from the per-material table where constant.
+    Color shadow_kt(const Material& m, const Ray& ray, const Hit& hit) const;
     /// The layered extensions' inputs at a point (factors x texture channels) into `s`.
     void layer_inputs(const Material& m, const SurfacePoint& sp, PbrSample& s) const;
     /// Coverage alpha at a hit (base color alpha x texture x vertex alpha), UV0/UV1 interpolated.
@@ -127,6 +132,7 @@ private:
                                       ///< world-space checker); 0 = surface() skips UVs and MIP levels
     SceneAnalysis m_analysis;
     std::shared_ptr<const EnvironmentMap> m_environment;  ///< built from scene.environment
+    std::vector<std::optional<Color>> m_constant_shadow_kt;  ///< per material: transmitted_light where constant
     std::vector<LightSample> m_directional_samples;  ///< per light: sample_light() of a directional one
 };
 

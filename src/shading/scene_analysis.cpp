@@ -64,6 +64,8 @@ MaterialFeatures material_features(const Material& m, const MappingOptions& mapp
         f.layered = true;
         f.highlight = f.mirror = true;
         f.diffuse |= m.diffuse_transmission > 0.f;
+        // Diffuse transmission lets shadow rays through (SceneView::transmittance).
+        f.transmission |= m.diffuse_transmission > 0.f;
     }
     return f;
 }
