@@ -74,6 +74,27 @@ TEST(LayeredRender, ClearcoatOnBlackIsItsFresnelTimesTheLight) {
     EXPECT_EQ(stats.rays.reflection, 1u);  // the coat's mirror ray (to the black background)
 }
 
+TEST(LayeredRender, ASmoothCoatOverASmoothBaseIsOneMirrorRay) {
+    // Coat and base share their normal (no normal maps) and both are mirrors: one reflected ray
+    // carries kr (1 - w) + w. A white background makes it the sum of the two weights.
+    Material m = gltf_dielectric(Color(0.f), 0.f);
+    m.metallic = 1.f;
+    m.base_color = {0.5f, 0.5f, 0.5f, 1.f};
+    m.clearcoat = 1.f;
+    m.clearcoat_roughness = 0.f;
+    RenderSettings rs = one_pixel();
+    rs.integrator.background = Color(1.f);
+    rs.integrator.ambient = Color(0.f);
+    RenderStats stats;
+    const Color I = render_pixel(facing_quad(m), rs, &stats);
+    EXPECT_EQ(stats.rays.reflection, 1u);
+    // Base kr = F0 = 0.5 at roughness 0; the coat's weight 0.04 at normal incidence.
+    expect_near(I, Color(0.5f * (1.f - 0.04f) + 0.04f), 1e-5f);
+    // Without the coat: the base's mirror alone.
+    m.clearcoat = 0.f;
+    expect_near(render_pixel(facing_quad(m), rs), Color(0.5f), 1e-6f);
+}
+
 TEST(LayeredRender, DiffuseTransmissionLetsLightThroughFromBehind) {
     // A white diffuse sheet with diffuse transmission 1, lit only from behind by a point light at
     // distance 2 of intensity 8: I = kdt (Is / d^2) |N.L| + Ia kdt, kdt = colour x 0.96.
