@@ -273,7 +273,29 @@ constexpr MaterialProperty kMaterialProperties[] = {
     {"alphaCutoff", 1, 0.f, 3.4e38f},
     {"normalTexture/scale", 1, -3.4e38f, 3.4e38f},
     {"occlusionTexture/strength", 1, 0.f, 1.f},
+    // The material extensions' factors (written into the material's extension object).
+    {"extensions/KHR_materials_emissive_strength/emissiveStrength", 1, 0.f, 3.4e38f},
+    {"extensions/KHR_materials_transmission/transmissionFactor", 1, 0.f, 1.f},
+    {"extensions/KHR_materials_ior/ior", 1, 0.f, 3.4e38f},
+    {"extensions/KHR_materials_specular/specularFactor", 1, 0.f, 1.f},
+    {"extensions/KHR_materials_specular/specularColorFactor", 3, 0.f, 3.4e38f},
+    {"extensions/KHR_materials_volume/thicknessFactor", 1, 0.f, 3.4e38f},
+    {"extensions/KHR_materials_volume/attenuationColor", 3, 0.f, 1.f},
+    {"extensions/KHR_materials_clearcoat/clearcoatFactor", 1, 0.f, 1.f},
+    {"extensions/KHR_materials_clearcoat/clearcoatRoughnessFactor", 1, 0.f, 1.f},
+    {"extensions/KHR_materials_sheen/sheenColorFactor", 3, 0.f, 1.f},
+    {"extensions/KHR_materials_sheen/sheenRoughnessFactor", 1, 0.f, 1.f},
+    {"extensions/KHR_materials_iridescence/iridescenceFactor", 1, 0.f, 1.f},
+    {"extensions/KHR_materials_iridescence/iridescenceIor", 1, 1.f, 3.4e38f},
+    {"extensions/KHR_materials_iridescence/iridescenceThicknessMinimum", 1, 0.f, 3.4e38f},
+    {"extensions/KHR_materials_iridescence/iridescenceThicknessMaximum", 1, 0.f, 3.4e38f},
+    {"extensions/KHR_materials_anisotropy/anisotropyStrength", 1, 0.f, 1.f},
+    {"extensions/KHR_materials_anisotropy/anisotropyRotation", 1, -3.4e38f, 3.4e38f},
+    {"extensions/KHR_materials_dispersion/dispersion", 1, 0.f, 3.4e38f},
+    {"extensions/KHR_materials_diffuse_transmission/diffuseTransmissionFactor", 1, 0.f, 1.f},
+    {"extensions/KHR_materials_diffuse_transmission/diffuseTransmissionColorFactor", 3, 0.f, 1.f},
 };
+constexpr const char* kExtensions = "extensions/";
 
 /// The core textureInfo slots of a material, and the KHR_texture_transform properties of each that
 /// KHR_animation_pointer may animate (any finite value).
@@ -466,6 +488,20 @@ namespace {
 
 /// Writes `property` ("offset", "rotation" or "scale") of the KHR_texture_transform of material
 /// `g`'s texture `slot` (kTextureSlots), adding the extension object where the file has none.
+/// Sets `member` of the JSON object `object` (made an object when it is not one) to a number or,
+/// for several values, an array.
+void set_member(tinygltf::Value& object, const std::string& member, const std::vector<double>& value) {
+    tinygltf::Value::Object members = object.IsObject() ? object.Get<tinygltf::Value::Object>() : tinygltf::Value::Object{};
+    if (value.size() == 1) {
+        members[member] = tinygltf::Value(value[0]);
+    } else {
+        tinygltf::Value::Array a;
+        for (const double x : value) a.emplace_back(x);
+        members[member] = tinygltf::Value(std::move(a));
+    }
+    object = tinygltf::Value(std::move(members));
+}
+
 void set_texture_transform(tinygltf::Material& g, const std::string& slot, const std::string& property,
                            const std::vector<double>& value) {
     tinygltf::ExtensionMap* extensions = slot == "pbrMetallicRoughness/baseColorTexture"
@@ -475,16 +511,7 @@ void set_texture_transform(tinygltf::Material& g, const std::string& slot, const
                                          : slot == "normalTexture"    ? &g.normalTexture.extensions
                                          : slot == "occlusionTexture" ? &g.occlusionTexture.extensions
                                                                       : &g.emissiveTexture.extensions;
-    tinygltf::Value& xf = (*extensions)["KHR_texture_transform"];
-    tinygltf::Value::Object members = xf.IsObject() ? xf.Get<tinygltf::Value::Object>() : tinygltf::Value::Object{};
-    if (value.size() == 1) {
-        members[property] = tinygltf::Value(value[0]);
-    } else {
-        tinygltf::Value::Array a;
-        for (const double x : value) a.emplace_back(x);
-        members[property] = tinygltf::Value(std::move(a));
-    }
-    xf = tinygltf::Value(std::move(members));
+    set_member((*extensions)["KHR_texture_transform"], property, value);
 }
 
 }  // namespace
@@ -505,6 +532,13 @@ void apply_pointer_values(const GltfPose& pose, tinygltf::Model& model) {
         tinygltf::Material& g = model.materials[size_t(m.index)];
         if (const size_t at = m.property.find(kTextureTransform); at != std::string::npos) {
             set_texture_transform(g, m.property.substr(0, at), m.property.substr(at + std::strlen(kTextureTransform)), d);
+            continue;
+        }
+        if (m.property.rfind(kExtensions, 0) == 0) {
+            // "extensions/KHR_materials_x/member": the extension object is added where the file has none.
+            const std::string rest = m.property.substr(std::strlen(kExtensions));
+            const size_t slash = rest.find('/');
+            set_member(g.extensions[rest.substr(0, slash)], rest.substr(slash + 1), d);
             continue;
         }
         if (m.property == "pbrMetallicRoughness/baseColorFactor") g.pbrMetallicRoughness.baseColorFactor = d;

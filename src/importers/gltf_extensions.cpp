@@ -47,8 +47,8 @@ constexpr std::array kTable = {
     Entry{"KHR_xmp", I, false, "metadata not read"},
     Entry{"KHR_xmp_json_ld", I, false, "metadata not read"},
     Entry{"KHR_animation_pointer", S, false,
-          "pointers to node TRS and weights, camera yfov, light color and intensity, core material factors "
-          "and core textures' KHR_texture_transform applied; other targets warn once each"},
+          "pointers to node TRS and weights, camera yfov, light color and intensity, core and extension material "
+          "factors and core textures' KHR_texture_transform applied; other targets warn once each"},
     Entry{"KHR_texture_basisu", I, true, "KTX2/Basis images not decoded; the core texture source is used when present"},
     Entry{"EXT_texture_webp", S, false, "WebP images decoded (libwebp), preferred over the core source"},
     Entry{"EXT_texture_avif", I, true, "AVIF images not decoded; the core texture source is used when present"},

@@ -11,9 +11,10 @@ KernelFeatures select_kernel(const SceneFeatures& scene, const IntegratorSetting
     k.attributes = scene.varying;
     k.transmission = !scene.opaque();
     k.mirror = scene.mirror || k.transmission;  // total internal reflection turns kt into kr
-    // Layered materials: per-hit evaluation with the texture frame, and the coat's mirror rays.
+    // Layered materials: per-hit evaluation with the texture frame (the analysis' mirror flag
+    // covers the coat's own mirror rays).
     k.layers = scene.layered;
-    if (k.layers) k.attributes = k.mirror = true;
+    if (k.layers) k.attributes = true;
     return k;
 }
 

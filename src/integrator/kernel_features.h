@@ -30,7 +30,8 @@ constexpr KernelFeatures kKernels[] = {
     {false, false, false, true, false}, {true, false, false, true, false},  // opaque, no recursion
     {false, true, false, true, false},  {true, true, false, true, false},   // opaque mirrors
     {false, true, true, true, false},   {true, true, true, true, false},    // glass (and mirrors)
-    {true, true, false, true, true},    {true, true, true, true, true},     // layered materials
+    {true, false, false, true, true},   {true, true, false, true, true},    // layered materials
+    {true, true, true, true, true},
 };
 
 /// The smallest kernel that renders a scene with these features exactly like the general one.

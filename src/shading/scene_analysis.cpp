@@ -60,9 +60,15 @@ MaterialFeatures material_features(const Material& m, const MappingOptions& mapp
     f.emissive = !is_black(m.emissive) && m.emissive_strength > 0.f;
     f.volume = f.transmission && m.has_volume && m.thickness > 0.f && !is_black(f.constant.absorption);
     if (m.layered()) {
-        // Evaluated per hit and view (layered_model.h); a coat reflects whatever the base does.
+        // Evaluated per hit and view (layered_model.h). Mirror rays: a smooth enough coat's own,
+        // and a thin film's (its Fresnel is not 0 where F0 is).
         f.layered = true;
-        f.highlight = f.mirror = true;
+        f.highlight = true;
+        const bool coat_mirror = m.clearcoat > 0.f && (m.clearcoat_roughness_texture.valid()
+                                                           ? mapping.mirror_roughness_cutoff > 0.f
+                                                           : mirror_fade(std::clamp(m.clearcoat_roughness, 0.f, 1.f),
+                                                                         mapping.mirror_roughness_cutoff) > 0.f);
+        f.mirror |= coat_mirror || (m.iridescence > 0.f && smooth_enough);
         f.diffuse |= m.diffuse_transmission > 0.f;
         // Diffuse transmission lets shadow rays through (SceneView::transmittance).
         f.transmission |= m.diffuse_transmission > 0.f;

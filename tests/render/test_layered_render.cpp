@@ -182,6 +182,29 @@ TEST(LayeredRender, ThreadsAndTilesDoNotChangeALayeredImage) {
     }
 }
 
+TEST(LayeredRender, AVelvetSceneRunsTheLayeredKernelWithoutMirrorsAndMatchesTheGeneralOne) {
+    // Sheen on a rough base casts no mirror ray: the smallest layered kernel, the same bits as the
+    // general kernel (which has every feature).
+    Scene s;
+    Material velvet = gltf_dielectric({0.2f, 0.1f, 0.3f}, 0.9f);
+    velvet.sheen_color = {1.f, 0.8f, 0.9f};
+    velvet.sheen_roughness = 0.5f;
+    add_mesh(s, make_box({-1, -1, -1}, {1, 1, 1}, add_material(s, velvet)), Mat4d::rotate(0.2, 0.3, 0.1, std::sqrt(1.0 - 0.14)));
+    add_mesh(s, make_quad({-6, -6, -1.5f}, {6, -6, -1.5f}, {6, 6, -1.5f}, {-6, 6, -1.5f}, add_material(s, gltf_dielectric(Color(0.7f), 1.f))));
+    s.lights.push_back(point_light({2, 3, 6}, 40.f));
+    s.lights.push_back(point_light({-4, 1, 2}, 10.f));
+    s.cameras.push_back(make_camera(CameraType::Perspective, {0, 0, 6}, {0, 0, -1}, {0, 1, 0}, 0.7));
+    RenderSettings rs = small(2, 16);
+    const Renderer special(s, rs);
+    EXPECT_TRUE(special.kernel().layers);
+    EXPECT_FALSE(special.kernel().mirror);
+    rs.integrator.specialize = false;
+    const Film a = special.render();
+    const Film b = Renderer(s, rs).render();
+    ASSERT_EQ(a.beauty.size(), b.beauty.size());
+    EXPECT_EQ(std::memcmp(a.beauty.data(), b.beauty.data(), a.beauty.size() * sizeof(Color)), 0);
+}
+
 TEST(LayeredRender, OnlyScenesWithALayerRunTheLayeredKernel) {
     EXPECT_TRUE(Renderer(glass_block(1.f), small(1, 16)).kernel().layers);
     EXPECT_FALSE(Renderer(glass_block(0.f), small(1, 16)).kernel().layers);

@@ -294,6 +294,39 @@ TEST(GltfAnimation, AnimationPointerToMaterialFactors) {
     for (const std::string& w : end.warnings) EXPECT_EQ(w.find("is not applied"), std::string::npos) << w;
 }
 
+// KHR_animation_pointer to the material extensions' factors: a clearcoat factor the file gives and
+// a sheen colour on a material without the extension (the extension object is added), LINEAR over
+// 0..1 s, read at 0.5 s; values past the range are clamped as the importer would.
+TEST(GltfAnimation, AnimationPointerToMaterialExtensionFactors) {
+    Glb b;
+    const int pos = b.floats(kTriangle, "VEC3", true);
+    const int in = b.floats({0, 1}, "SCALAR", true);
+    const int coat = b.floats({0.2f, 1.6f}, "SCALAR");
+    const int sheen = b.floats({0, 0, 0, 1, 0.5f, 0.25f}, "VEC3");
+    const auto glb = b.glb(fill(R"("scene":0,"scenes":[{"nodes":[0]}],
+        "extensionsUsed":["KHR_animation_pointer","KHR_materials_clearcoat"],
+        "nodes":[{"name":"tri","mesh":0}],
+        "materials":[{"extensions":{"KHR_materials_clearcoat":{"clearcoatFactor":0.5,"clearcoatRoughnessFactor":0.3}}}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":@pos@},"material":0}]}],
+        "animations":[{"samplers":[{"input":@in@,"output":@coat@},{"input":@in@,"output":@sheen@}],
+          "channels":[{"sampler":0,"target":{"path":"pointer","extensions":{"KHR_animation_pointer":
+                         {"pointer":"/materials/0/extensions/KHR_materials_clearcoat/clearcoatFactor"}}}},
+                      {"sampler":1,"target":{"path":"pointer","extensions":{"KHR_animation_pointer":
+                         {"pointer":"/materials/0/extensions/KHR_materials_sheen/sheenColorFactor"}}}}]}])",
+                                {{"pos", pos}, {"in", in}, {"coat", coat}, {"sheen", sheen}}));
+    const Scene still = import(glb, at_time(0.0));
+    EXPECT_NEAR(still.materials[0].clearcoat, 0.2, 1e-6);
+    const Scene half = import(glb, at_time(0.5));
+    EXPECT_NEAR(half.materials[0].clearcoat, 0.9, 1e-6);
+    EXPECT_NEAR(half.materials[0].clearcoat_roughness, 0.3, 1e-6);  // not animated: as the file gives it
+    EXPECT_NEAR(half.materials[0].sheen_color.x, 0.5, 1e-6);
+    EXPECT_NEAR(half.materials[0].sheen_color.y, 0.25, 1e-6);
+    EXPECT_NEAR(half.materials[0].sheen_color.z, 0.125, 1e-6);
+    EXPECT_TRUE(half.materials[0].layered());
+    EXPECT_NEAR(import(glb, at_time(1.0)).materials[0].clearcoat, 1.0, 1e-6);  // 1.6 clamped
+    for (const std::string& w : half.warnings) EXPECT_EQ(w.find("is not applied"), std::string::npos) << w;
+}
+
 // KHR_animation_pointer to a camera's yfov and a light's color and intensity (LINEAR from 0 s to
 // 1 s, here at 0.5 s: halfway), and a yfov animated out of (0, pi) is an error naming the channel.
 TEST(GltfAnimation, AnimationPointerToCameraAndLight) {
