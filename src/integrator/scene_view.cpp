@@ -244,7 +244,9 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
     }
     sp.nc = ns;
     const Material& mat = m_scene.materials[mesh.material];
-    const bool layered = mat.model == MaterialModel::GltfPbr && mat.layered();
+    // The layers that read the texture-space frame: anisotropy's direction, the coat's normal map.
+    const bool layered = mat.model == MaterialModel::GltfPbr && mat.layered() &&
+                         (mat.anisotropy_strength > 0.f || mat.clearcoat_normal_texture.valid());
     if (kAttributes && !mesh.tangents.empty() && mat.model == MaterialModel::GltfPbr &&
         (mat.normal_texture.valid() || layered)) {
         // The texture-space frame: the tangent Gram-Schmidt'ed against the interpolated normal.
@@ -261,8 +263,6 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
                 return mapped != Vec3f(0.f) && is_finite(mapped) ? mapped : ns;
             };
             if (layered) {
-                // KHR_materials_clearcoat's own normal map over the interpolated normal;
-                // KHR_materials_anisotropy's direction lives in this frame.
                 if (mat.clearcoat_normal_texture.valid()) sp.nc = mapped_normal(mat.clearcoat_normal_texture);
                 sp.tangent = t;
                 sp.bitangent = b;
