@@ -11,17 +11,11 @@ namespace whitted {
 
 namespace {
 
-inline float saturate(float x) { return x > 0.f ? (x < 1.f ? x : 1.f) : 0.f; }
-inline Color saturate(const Color& c) { return {saturate(c.x), saturate(c.y), saturate(c.z)}; }
-
 /// Normal-incidence reflectance of the clearcoat (ior 1.5), as KHR_materials_clearcoat fixes it.
 constexpr float kCoatF0 = 0.04f;
 
-/// (N.H)^e above the highlight cutoff, else 0 (local_model.h).
-inline float lobe(float n_dot_h, float e) {
-    if (!(n_dot_h > 0.f) || e * (1.f - n_dot_h) >= kHighlightCutoff) return 0.f;
-    return std::pow(n_dot_h, e);
-}
+/// highlight_lobe (local_model.h), 0 for N.H <= 0 or NaN.
+inline float lobe(float n_dot_h, float e) { return n_dot_h > 0.f ? highlight_lobe(n_dot_h, e) : 0.f; }
 
 /// Ashikhmin & Shirley's (2000) anisotropic Phong lobe: exponent n_t along T, n_b along B.
 inline float anisotropic_lobe(const LayerCoeffs& l, const Vec3f& N, const Vec3f& H) {

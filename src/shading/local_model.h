@@ -39,6 +39,12 @@ inline float environment_highlight_scale(float n) {
     return std::min(1.f, 1.f / highlight_integral(n)) * environment_highlight_weight(n);
 }
 
+/// The highlight's lobe (N.H)^n for N.H = n_dot_h >= 0, and 0 where the cutoff above makes it
+/// invisible (the pow is then not evaluated).
+inline float highlight_lobe(float n_dot_h, float n) {
+    return n * (1.f - n_dot_h) < kHighlightCutoff ? std::pow(n_dot_h, n) : 0.f;
+}
+
 /// kd (N.L) + ks (N.H)^n for unit N, L (toward the light) and V (toward the viewer), n_dot_l = N.L > 0.
 /// highlight_scale: 1 but for the lights extracted from an environment (environment_highlight_scale).
 inline Color local_term(const WhittedCoeffs& c, const Vec3f& N, const Vec3f& L, const Vec3f& V, float n_dot_l,
@@ -47,7 +53,7 @@ inline Color local_term(const WhittedCoeffs& c, const Vec3f& N, const Vec3f& L, 
     if (!is_black(c.ks)) {
         const Vec3f H = normalize(L + V);
         const float n_dot_h = std::max(0.f, dot(N, H));
-        if (c.n * (1.f - n_dot_h) < kHighlightCutoff) term += c.ks * (std::pow(n_dot_h, c.n) * highlight_scale);
+        if (const float lobe = highlight_lobe(n_dot_h, c.n); lobe > 0.f) term += c.ks * (lobe * highlight_scale);
     }
     return term;
 }

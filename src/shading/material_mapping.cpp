@@ -17,9 +17,6 @@ constexpr float kMinAttenuationColor = 1e-6f;
 /// F0 of the glTF default ior 1.5, used for invalid (negative or NaN) ior values.
 constexpr float kDefaultF0 = 0.04f;
 
-/// Clamp to [0, 1] with NaN -> 0.
-inline float saturate(float x) { return x > 0.f ? (x < 1.f ? x : 1.f) : 0.f; }
-inline Color saturate(const Color& c) { return {saturate(c.x), saturate(c.y), saturate(c.z)}; }
 
 /// Finite and non-negative, anything else (negative, NaN, infinity) -> 0.
 inline float finite_nonneg(float x) { return (x > 0.f && std::isfinite(x)) ? x : 0.f; }

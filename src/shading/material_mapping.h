@@ -11,6 +11,10 @@
 
 namespace whitted {
 
+/// Clamp to [0, 1] with NaN -> 0 (per channel for colours): how the mappings read their inputs.
+inline float saturate(float x) { return x > 0.f ? (x < 1.f ? x : 1.f) : 0.f; }
+inline Color saturate(const Color& c) { return {saturate(c.x), saturate(c.y), saturate(c.z)}; }
+
 /// Settings of the mapping; every field documented in docs/materials.md.
 struct MappingOptions {
     float mirror_roughness_cutoff = 0.3f;  ///< roughness at/above which mirror reflection (kr) is 0; <= 0 disables kr
