@@ -38,6 +38,7 @@
 #include "benchmarks/bench_commands.h"
 #include "benchmarks/bench_images.h"
 #include "benchmarks/irradiance_check.h"
+#include "benchmarks/occlusion_scene.h"
 #include "benchmarks/bench_timing.h"
 #include "importers/environment_image.h"
 #include "importers/scene_loader.h"
@@ -74,6 +75,11 @@ struct BenchEnvOptions {
     std::vector<std::string> split_maps;                   ///< its maps; empty = every bundled one
     std::vector<int> split_counts{4, 16, 64, 128, 256};    ///< its light counts
     int split_normals = 100;                               ///< random normals its error is measured at (besides the 6 axes)
+    std::vector<int> occlusion{0, 4, 16, 36, 64};           ///< --env-occlusion budgets compared (0 = off)
+    int occlusion_reference = 1024;                        ///< the budget they are compared against
+    std::vector<std::string> occlusion_maps{"furnace", "studio", "courtyard"};  ///< environments of the occlusion sweep
+    std::vector<std::string> occlusion_scenes;             ///< its scenes; empty = the generated occlusion scene and default.glb
+    bool occlusion_sweep = true;                           ///< measure the occlusion budgets at all
     bool plot = true;                                      ///< run scripts/plot_env.py afterwards when possible
     std::string python = default_python();                        ///< interpreter with matplotlib for the plot
 };
@@ -106,9 +112,11 @@ std::string label_of(const std::string& path) { return fs::path(path).stem().str
 
 /// The bench's render settings for `scene`: its file's settings, then the bench's size, threads,
 /// anti-aliasing and min weight (what the file sets of the latter wins, as in `render`).
-RenderSettings bench_settings(const Scene& scene, const BenchEnvOptions& o) {
+/// `occlusion`: the --env-occlusion budget (the lookup-cost measurement turns it off).
+RenderSettings bench_settings(const Scene& scene, const BenchEnvOptions& o, int occlusion = kDefaultEnvOcclusion) {
     RenderSettings rs;
     rs.integrator.min_weight = o.min_weight;
+    rs.integrator.env_occlusion = occlusion;
     apply_scene_settings(scene.settings, rs);
     rs.width = o.width;
     rs.height = 0;
@@ -128,9 +136,9 @@ struct Timed {
     RenderStats stats;              ///< of the last run (every run traces the same rays)
     Film film;                      ///< of the last run (every run gives the same image)
 
-    Timed(Scene s, const BenchEnvOptions& o)
+    Timed(Scene s, const BenchEnvOptions& o, int occlusion = kDefaultEnvOcclusion)
         : scene(std::make_unique<Scene>(std::move(s))),
-          renderer(std::make_unique<Renderer>(*scene, bench_settings(*scene, o))) {}
+          renderer(std::make_unique<Renderer>(*scene, bench_settings(*scene, o, occlusion))) {}
 
     /// Renders once and records its times.
     void run(bool cpu_timing) {
@@ -321,9 +329,9 @@ void lookup_overhead(const BenchEnvOptions& o, const std::string& map, const fs:
         if (std::none_of(env_scene.lights.begin(), env_scene.lights.end(), is_default))
             std::erase_if(plain_scene.lights, is_default);
         const size_t lights = env_scene.lights.size();
-        Timed plain(std::move(plain_scene), o), env(std::move(env_scene), o);
+        Timed plain(std::move(plain_scene), o, 0), env(std::move(env_scene), o, 0);
         time_interleaved({&plain, &env}, o.overhead_repeat, 0.0, cpu_timing);
-        const RenderSettings rs = bench_settings(*env.scene, o);
+        const RenderSettings rs = bench_settings(*env.scene, o, 0);
         const std::string terms = fmt::format("{}{}", rs.integrator.environment_visible ? "background" : "(hidden)",
                                               rs.integrator.environment_ambient ? " + SH9 ambient" : " (file's ambient)");
         const double ratio = env.seconds(cpu_timing) / plain.seconds(cpu_timing);
@@ -337,6 +345,121 @@ void lookup_overhead(const BenchEnvOptions& o, const std::string& map, const fs:
                            size.width, size.height, env.stats.threads, load_average_1min());
         csv.flush();
     }
+}
+
+// ---- occlusion: --env-occlusion budgets against a high budget ------------------------------------
+
+/// What one occlusion budget measured on one scene and map.
+struct OcclusionRow {
+    std::string scene, map;
+    int budget = 0;
+    double psnr = 0.0;        ///< display values against the reference budget, dB (inf: identical)
+    double rmse_codes = 0.0;  ///< the same error in 8-bit codes
+    double mean_ratio = 1.0;  ///< mean linear value over the reference's
+    double psnr_previous = 0.0;  ///< against the next smaller budget compared (0: none)
+    double seconds = 0.0;
+    RenderStats stats;
+};
+
+double psnr_of(double rmse_display) { return rmse_display > 0.0 ? 20.0 * std::log10(1.0 / rmse_display) : kInfinity; }
+
+double mean_of(const std::vector<float>& v) {
+    double sum = 0.0;
+    for (const float x : v) sum += double(x);
+    return v.empty() ? 0.0 : sum / double(v.size());
+}
+
+/// Renders every scene under every map at each budget and compares the display images with the
+/// reference budget's; prints the cheapest budget within 40 dB everywhere.
+void occlusion_sweep(const BenchEnvOptions& o, const fs::path& out) {
+    const bool cpu_timing = o.timing == "cpu";
+    const DisplayTransform display(ColorSettings{});
+    std::vector<int> budgets = o.occlusion;
+    budgets.push_back(o.occlusion_reference);
+    std::sort(budgets.begin(), budgets.end());
+    budgets.erase(std::unique(budgets.begin(), budgets.end()), budgets.end());
+    std::vector<std::string> scenes = o.occlusion_scenes;
+    if (scenes.empty()) {
+        const fs::path generated = out / "occlusion.glb";
+        const size_t triangles = write_occlusion_scene(generated);
+        std::printf("== occlusion scene: %s (%zu triangles)\n", generated.c_str(), triangles);
+        scenes = {generated.string(), (fs::path(WHITTED_SOURCE_DIR) / "assets" / "scenes" / "default.glb").string()};
+    }
+    std::ofstream csv(out / "env_occlusion.csv");
+    csv << "scene,map,budget,reference,psnr_display,rmse_display_codes,mean_ratio,psnr_previous,seconds,timing,runs,"
+           "occlusion_rays,occlusion_skipped_dim,reflection_rays,total_rays,width,height,threads,load\n";
+    std::vector<OcclusionRow> rows;
+    for (const std::string& path : scenes) {
+        for (const std::string& map : o.occlusion_maps) {
+            ImportOptions io;
+            io.environment = map;
+            const Scene loaded = load_scene(path, io);
+            std::vector<Timed> timed;
+            timed.reserve(budgets.size());
+            for (const int b : budgets) timed.emplace_back(Scene(loaded), o, b);
+            const ImageSize size = timed.front().renderer->image_size();
+            std::printf("== occlusion: %s / %s: %dx%d, %s, %s time, load %.2f\n", label_of(path).c_str(), map.c_str(),
+                        size.width, size.height, o.aa.c_str(), cpu_timing ? "process CPU" : "wall", load_average_1min());
+            std::vector<Timed*> batch;
+            for (Timed& t : timed) batch.push_back(&t);
+            time_interleaved(batch, o.repeat, 2.0, cpu_timing);
+            const size_t ref_index = size_t(std::find(budgets.begin(), budgets.end(), o.occlusion_reference) - budgets.begin());
+            const std::vector<float> ref_linear = packed_rgb(timed[ref_index].film);
+            const std::vector<float> ref_display = display_rgb(ref_linear, display);
+            const double ref_mean = mean_of(ref_linear);
+            std::printf("   %6s %9s %7s %7s %10s %9s %13s %12s\n", "budget", "PSNR[dB]", "codes", "mean", "PSNR prev",
+                        "time[s]", "occl. rays", "refl. rays");
+            std::vector<float> previous;
+            for (size_t k = 0; k < budgets.size(); ++k) {
+                Timed& t = timed[k];
+                OcclusionRow r;
+                r.scene = label_of(path);
+                r.map = map;
+                r.budget = budgets[k];
+                const std::vector<float> disp = display_rgb(packed_rgb(t.film), display);
+                const double e = rmse(disp, ref_display);
+                r.psnr = psnr_of(e);
+                r.rmse_codes = e / kOneCode;
+                r.mean_ratio = ref_mean > 0.0 ? mean_of(packed_rgb(t.film)) / ref_mean : 1.0;
+                r.psnr_previous = previous.empty() ? 0.0 : psnr_of(rmse(disp, previous));
+                r.seconds = t.seconds(cpu_timing);
+                r.stats = t.stats;
+                write_image(t.film, (out / fmt::format("occlusion-{}-{}-{}.png", r.scene, label_of(map), r.budget)).string(),
+                            OutputSettings{});
+                t.film = Film{};
+                previous = disp;
+                std::printf("   %6d %9.2f %7.2f %7.4f %10.2f %9.4f %13llu %12llu\n", r.budget, r.psnr, r.rmse_codes,
+                            r.mean_ratio, r.psnr_previous, r.seconds, (unsigned long long)r.stats.rays.occlusion,
+                            (unsigned long long)r.stats.rays.reflection);
+                csv << fmt::format("{},{},{},{},{:.3f},{:.4f},{:.5f},{:.3f},{:.6f},{},{},{},{},{},{},{},{},{},{:.2f}\n", r.scene,
+                                   r.map, r.budget, o.occlusion_reference, r.psnr, r.rmse_codes, r.mean_ratio,
+                                   r.psnr_previous, r.seconds, o.timing, t.cpu.size(), r.stats.rays.occlusion,
+                                   r.stats.rays.occlusion_skipped_dim, r.stats.rays.reflection, r.stats.rays.total(),
+                                   size.width, size.height, r.stats.threads, load_average_1min());
+                csv.flush();
+                rows.push_back(std::move(r));
+            }
+        }
+    }
+    // The cheapest budget within 40 dB of the reference on every scene and map.
+    std::printf("== occlusion budget: the least total time with PSNR >= 40 dB against budget %d everywhere\n",
+                o.occlusion_reference);
+    int chosen = -1;
+    for (const int b : budgets) {
+        double seconds = 0.0, worst = kInfinity;
+        const OcclusionRow* worst_row = nullptr;
+        for (const OcclusionRow& r : rows) {
+            if (r.budget != b) continue;
+            seconds += r.seconds;
+            if (r.psnr < worst) worst = r.psnr, worst_row = &r;
+        }
+        const bool within = worst >= 40.0;
+        if (within && chosen < 0) chosen = b;
+        std::printf("   %6d %9.4f s  worst %6.2f dB%s%s\n", b, seconds, worst,
+                    worst_row ? fmt::format(" ({} / {})", worst_row->scene, worst_row->map).c_str() : "",
+                    b == kDefaultEnvOcclusion ? "  <- kDefaultEnvOcclusion" : "");
+    }
+    std::printf("   chosen: %d (kDefaultEnvOcclusion = %d)\n", chosen, kDefaultEnvOcclusion);
 }
 
 // ---- the split alone: threshold rule and light count against irradiance error ----------------------
@@ -426,6 +549,9 @@ int run_bench_env(const BenchEnvOptions& o) {
         if (n < 0) throw Error(fmt::format("bench env: --split-counts: counts are 0 or more (got {})", n));
     for (const int n : o.lights)
         if (n < 0) throw Error(fmt::format("bench env: --lights: counts are 0 or more (got {})", n));
+    for (const int n : o.occlusion)
+        if (n < 0 || n > kMaxEnvOcclusion)
+            throw Error(fmt::format("bench env: --occlusion: budgets are 0 to {} (got {})", kMaxEnvOcclusion, n));
     (void)parse_aa_mode(o.aa);
     const fs::path out(o.out);
     fs::create_directories(out);
@@ -438,6 +564,7 @@ int run_bench_env(const BenchEnvOptions& o) {
     const std::vector<Row> rows = light_sweep(o, counts, out);
     print_choice(o, counts, rows);
     if (o.overhead) lookup_overhead(o, o.maps.front(), out);
+    if (o.occlusion_sweep) occlusion_sweep(o, out);
     if (o.split) split_table(o, out);
     const std::string overhead_csv = o.overhead ? ", " + (out / "env_overhead.csv").string() : "";
     const std::string split_csv =
@@ -489,6 +616,15 @@ Command register_bench_env(CLI::App& bench) {
                     "the 6 axes)")->check(CLI::Range(1, 100000))->capture_default_str();
     app->add_option("--out", o->out, "Output directory: env.csv, env_overhead.csv, env_split*.csv, PNGs, plot")
         ->capture_default_str();
+    app->add_option("--occlusion", o->occlusion, "--env-occlusion budgets to compare, comma-separated (0 = off)")
+        ->delimiter(',')->capture_default_str();
+    app->add_option("--occlusion-reference", o->occlusion_reference, "The budget every other is compared against")
+        ->check(CLI::Range(1, kMaxEnvOcclusion))->capture_default_str();
+    app->add_option("--occlusion-maps", o->occlusion_maps, "Environments of the occlusion sweep, comma-separated")
+        ->delimiter(',')->capture_default_str();
+    app->add_option("--occlusion-scenes", o->occlusion_scenes, "Scenes of the occlusion sweep (default: the generated "
+                    "occlusion scene, written to the output directory, and assets/scenes/default.glb)")->delimiter(',');
+    app->add_flag("!--no-occlusion", o->occlusion_sweep, "Skip the occlusion sweep");
     app->add_flag("!--no-plot", o->plot, "Do not run scripts/plot_env.py");
     app->add_option("--python", o->python, "Python interpreter with matplotlib for the plot")->capture_default_str();
     return Command{app, [o] { return run_bench_env(*o); }};

@@ -35,6 +35,51 @@ struct GlbLayout {
     }
 };
 
+/// Vertex attributes and triangles of one mesh.
+struct MeshData {
+    std::vector<float> positions, normals, uvs, tangents;
+    std::vector<uint32_t> indices;
+
+    size_t vertices() const { return positions.size() / 3; }
+    void vertex(double px, double py, double pz, double nx, double ny, double nz, double u, double v, double tx,
+                double ty, double tz, double w) {
+        positions.insert(positions.end(), {float(px), float(py), float(pz)});
+        normals.insert(normals.end(), {float(nx), float(ny), float(nz)});
+        uvs.insert(uvs.end(), {float(u), float(v)});
+        tangents.insert(tangents.end(), {float(tx), float(ty), float(tz), float(w)});
+    }
+};
+
+/// A UV sphere of `radius` about the origin: vertex (i, j) at longitude 2 pi i / segments and
+/// colatitude pi j / rings, with a seam column (u = 1) and pole rows; u runs with the longitude, v
+/// from the top pole down. The tangent is dP/du (about +Y), the bitangent cross(N, T) = dP/dv
+/// (w = +1). Triangles are counter-clockwise seen from outside; the degenerate ones at the poles are
+/// left out.
+MeshData uv_sphere(double radius, int segments, int rings);
+
+/// A floor: one quad at y = 0 facing +Y over x in [-half_x, half_x], z in [z_back, z_front]; u along
+/// +x, v along +z (so w = -1: cross(N, T) = -z).
+MeshData floor_quad(double half_x, double z_back, double z_front);
+
+/// Adds a mesh's accessors (POSITION with its bounds, NORMAL, and TEXCOORD_0 and TANGENT when the mesh
+/// has them); returns the primitive's "attributes" and "indices" JSON (no material).
+std::string add_mesh(GlbLayout& l, const MeshData& m);
+
+/// The unit quaternion (x, y, z, w) turning -Z (where glTF cameras look and lights shine) to unit d,
+/// as JSON; d must not be +Z.
+std::string rotation_to(double dx, double dy, double dz);
+
+/// A pbrMetallicRoughness block (JSON member).
+std::string pbr(double r, double g, double b, double metallic, double roughness);
+
+/// The glTF JSON of a generated scene: the asset's `generator`, `members` (whole top-level members,
+/// each ending in ",\n": extensionsUsed, extensions), one scene of every node, one perspective
+/// camera (aspect 4:3, vertical field of view `yfov` radians), the meshes, materials and l's
+/// accessors, views and buffer.
+std::string scene_json(const std::string& generator, const std::string& members, const std::vector<std::string>& nodes,
+                       const std::vector<std::string>& meshes, const std::vector<std::string>& materials, double yfov,
+                       const GlbLayout& l);
+
 /// The items joined by `separator`.
 std::string join(const std::vector<std::string>& items, const char* separator);
 

@@ -28,93 +28,6 @@ constexpr double kFloorX = 4.0;   ///< the floor spans x in [-4, 4], z in [kFloo
 constexpr double kFloorBack = -3.0, kFloorFront = 2.0;
 
 
-/// Vertex attributes and triangles of one mesh.
-struct MeshData {
-    std::vector<float> positions, normals, uvs, tangents;
-    std::vector<uint32_t> indices;
-
-    size_t vertices() const { return positions.size() / 3; }
-    void vertex(double px, double py, double pz, double nx, double ny, double nz, double u, double v, double tx,
-                double ty, double tz, double w) {
-        positions.insert(positions.end(), {float(px), float(py), float(pz)});
-        normals.insert(normals.end(), {float(nx), float(ny), float(nz)});
-        uvs.insert(uvs.end(), {float(u), float(v)});
-        tangents.insert(tangents.end(), {float(tx), float(ty), float(tz), float(w)});
-    }
-};
-
-/// A UV sphere about the origin: vertex (i, j) at longitude 2 pi i / kSegments and colatitude
-/// pi j / kRings, with a seam column (u = 1) and pole rows; u runs with the longitude, v from the
-/// top pole down. The tangent is dP/du (about +Y), the bitangent cross(N, T) = dP/dv (w = +1).
-/// Triangles are counter-clockwise seen from outside; the degenerate ones at the poles are left out.
-MeshData uv_sphere() {
-    MeshData m;
-    for (int j = 0; j <= kRings; ++j) {
-        const double theta = std::numbers::pi * j / kRings;
-        for (int i = 0; i <= kSegments; ++i) {
-            const double phi = 2.0 * std::numbers::pi * i / kSegments;
-            const double nx = std::sin(theta) * std::cos(phi), ny = std::cos(theta), nz = std::sin(theta) * std::sin(phi);
-            m.vertex(kRadius * nx, kRadius * ny, kRadius * nz, nx, ny, nz, double(i) / kSegments, double(j) / kRings,
-                     -std::sin(phi), 0.0, std::cos(phi), 1.0);
-        }
-    }
-    const uint32_t row = kSegments + 1;
-    for (uint32_t j = 0; j < uint32_t(kRings); ++j)
-        for (uint32_t i = 0; i < uint32_t(kSegments); ++i) {
-            const uint32_t a = j * row + i, b = a + 1, c = a + row, d = c + 1;
-            if (j > 0) m.indices.insert(m.indices.end(), {a, b, c});               // not at the top pole
-            if (j + 1 < uint32_t(kRings)) m.indices.insert(m.indices.end(), {b, d, c});  // not at the bottom pole
-        }
-    return m;
-}
-
-/// The floor: one quad at y = 0 facing +Y; u along +x, v along +z (so w = -1: cross(N, T) = -z).
-MeshData floor_quad() {
-    MeshData m;
-    const double w = 2.0 * kFloorX, d = kFloorFront - kFloorBack;
-    const double corners[4][2] = {{-kFloorX, kFloorBack}, {-kFloorX, kFloorFront}, {kFloorX, kFloorFront},
-                                  {kFloorX, kFloorBack}};
-    for (const auto& [x, z] : corners)
-        m.vertex(x, 0.0, z, 0.0, 1.0, 0.0, (x + kFloorX) / w, (z - kFloorBack) / d, 1.0, 0.0, 0.0, -1.0);
-    m.indices = {0, 1, 2, 0, 2, 3};
-    return m;
-}
-
-/// Adds a mesh's accessors; returns the primitive's "attributes" and "indices" JSON (no material).
-std::string add_mesh(GlbLayout& l, const MeshData& m) {
-    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
-    for (size_t v = 0; v < m.vertices(); ++v)
-        for (size_t c = 0; c < 3; ++c) {
-            lo[c] = std::min(lo[c], m.positions[3 * v + c]);
-            hi[c] = std::max(hi[c], m.positions[3 * v + c]);
-        }
-    const std::string bounds =
-        fmt::format(", \"min\": [{}, {}, {}], \"max\": [{}, {}, {}]", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
-    const int pos = l.add(m.positions, 5126, "VEC3", m.vertices(), 34962, bounds);
-    const int nrm = l.add(m.normals, 5126, "VEC3", m.vertices(), 34962);
-    const int uv = l.add(m.uvs, 5126, "VEC2", m.vertices(), 34962);
-    const int tan = l.add(m.tangents, 5126, "VEC4", m.vertices(), 34962);
-    const int idx = l.add(m.indices, 5125, "SCALAR", m.indices.size(), 34963);
-    return fmt::format("\"attributes\": {{\"POSITION\": {}, \"NORMAL\": {}, \"TEXCOORD_0\": {}, \"TANGENT\": {}}}, "
-                       "\"indices\": {}",
-                       pos, nrm, uv, tan, idx);
-}
-
-/// The unit quaternion (x, y, z, w) turning -Z (where glTF cameras look and lights shine) to unit `d`.
-std::string rotation_to(double dx, double dy, double dz) {
-    // q = (cross(a, d), 1 + dot(a, d)) normalised, a = (0, 0, -1); d is never +Z here.
-    const double x = dy, y = -dx, z = 0.0, w = 1.0 - dz;
-    const double n = std::sqrt(x * x + y * y + z * z + w * w);
-    return fmt::format("[{}, {}, {}, {}]", float(x / n), float(y / n), float(z / n), float(w / n));
-}
-
-/// A pbrMetallicRoughness block.
-std::string pbr(double r, double g, double b, double metallic, double roughness) {
-    return fmt::format("\"pbrMetallicRoughness\": {{\"baseColorFactor\": [{}, {}, {}, 1], \"metallicFactor\": {}, "
-                       "\"roughnessFactor\": {}}}",
-                       float(r), float(g), float(b), float(metallic), float(roughness));
-}
-
 /// Sphere k's material (t = k / 4, 0..1) for `extension`, as JSON.
 std::string sphere_material(const std::string& extension, int k) {
     const double t = double(k) / double(kSpheres - 1);
@@ -181,9 +94,9 @@ MaterialSample write_material_sample(const std::filesystem::path& path, const st
 
     // Geometry: one sphere mesh shared by the 5 sphere meshes (a material each), and the floor.
     GlbLayout l;
-    const MeshData sphere = uv_sphere(), floor = floor_quad();
+    const MeshData sphere = uv_sphere(kRadius, kSegments, kRings), floor = floor_quad(kFloorX, kFloorBack, kFloorFront);
     const std::string sphere_prim = add_mesh(l, sphere), floor_prim = add_mesh(l, floor);
-    std::vector<std::string> meshes, materials, nodes, roots;
+    std::vector<std::string> meshes, materials, nodes;
     for (int k = 0; k < kSpheres; ++k) {
         materials.push_back(sphere_material(extension, k));
         meshes.push_back(fmt::format("{{\"name\": \"sphere {}\", \"primitives\": [{{{}, \"material\": {}}}]}}", k,
@@ -210,28 +123,18 @@ MaterialSample write_material_sample(const std::filesystem::path& path, const st
     nodes.push_back(fmt::format("{{\"name\": \"sun\", \"rotation\": {}, \"extensions\": {{\"KHR_lights_punctual\": "
                                 "{{\"light\": 0}}}}}}",
                                 rotation_to(d[0] / n, d[1] / n, d[2] / n)));
-    for (size_t i = 0; i < nodes.size(); ++i) roots.push_back(std::to_string(i));
 
     std::vector<std::string> used{"\"KHR_lights_punctual\"", fmt::format("\"{}\"", material_extension_gltf_name(extension))};
     if (extension == "dispersion")
         for (const char* e : {"KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_ior"})
             used.push_back(fmt::format("\"{}\"", e));
-    const std::string json = fmt::format(
-        "{{\"asset\": {{\"version\": \"2.0\", \"generator\": \"whitted bench materials (benchmarks/material_samples.cpp)\"}},\n"
-        " \"extensionsUsed\": [{}],\n"
-        " \"extensions\": {{\"KHR_lights_punctual\": {{\"lights\": [{{\"name\": \"sun\", \"type\": \"directional\", "
-        "\"intensity\": 2}}]}}}},\n"
-        " \"scene\": 0, \"scenes\": [{{\"nodes\": [{}]}}],\n"
-        " \"nodes\": [\n  {}],\n"
-        " \"cameras\": [{{\"type\": \"perspective\", \"perspective\": {{\"yfov\": 0.72, \"aspectRatio\": 1.3333334, "
-        "\"znear\": 0.05}}}}],\n"
-        " \"meshes\": [\n  {}],\n"
-        " \"materials\": [\n  {}],\n"
-        " \"accessors\": [\n  {}],\n"
-        " \"bufferViews\": [\n  {}],\n"
-        " \"buffers\": [{{\"byteLength\": {}}}]}}\n",
-        join(used, ", "), join(roots, ", "), join(nodes, ",\n  "), join(meshes, ",\n  "), join(materials, ",\n  "),
-        join(l.accessors, ",\n  "), join(l.views, ",\n  "), l.bin.size());
+    const std::string json = scene_json(
+        "whitted bench materials (benchmarks/material_samples.cpp)",
+        fmt::format(" \"extensionsUsed\": [{}],\n"
+                    " \"extensions\": {{\"KHR_lights_punctual\": {{\"lights\": [{{\"name\": \"sun\", \"type\": "
+                    "\"directional\", \"intensity\": 2}}]}}}},\n",
+                    join(used, ", ")),
+        nodes, meshes, materials, 0.72, l);
 
     const size_t total = write_glb(path, json, l.bin, "material sample");
 

@@ -164,7 +164,8 @@ const std::set<std::string>& render_keywords() {
     static const std::set<std::string> k{"width", "height", "camera", "aa", "aa_threshold", "aa_depth", "spp", "filter", "texture_filter",
                                          "max_depth", "min_weight", "fresnel", "specialize", "refract_thin",
                                          "mirror_cutoff", "max_exponent", "exposure", "background", "ambient",
-                                         "tile_size", "threads", "crop", "aov", "accel", "robust", "progress"};
+                                         "tile_size", "threads", "crop", "aov", "accel", "robust", "progress",
+                                         "env_occlusion"};
     return k;
 }
 
@@ -208,6 +209,11 @@ RenderSettings render_settings(const PyScene& s, const py::kwargs& kw) {
         else if (key == "accel") rs.accel = v.cast<std::string>();
         else if (key == "robust") rs.robust = v.cast<bool>();
         else if (key == "progress") rs.progress = v.cast<bool>();
+        else if (key == "env_occlusion") {  // "off", False or a number of directions
+            if (py::isinstance<py::bool_>(v)) rs.integrator.env_occlusion = v.cast<bool>() ? kDefaultEnvOcclusion : 0;
+            else if (py::isinstance<py::str>(v)) rs.integrator.env_occlusion = parse_env_occlusion(v.cast<std::string>(), "env_occlusion");
+            else rs.integrator.env_occlusion = parse_env_occlusion(std::to_string(v.cast<long>()), "env_occlusion");
+        }
         else if (key == "aov") {
             rs.aovs = py::isinstance<py::str>(v) ? parse_aovs({v.cast<std::string>()})
                                                 : parse_aovs(v.cast<std::vector<std::string>>());
@@ -235,6 +241,7 @@ py::dict stats_dict(const RenderStats& st) {
     d["shadow_rays"] = st.rays.shadow;
     d["reflection_rays"] = st.rays.reflection;
     d["refraction_rays"] = st.rays.refraction;
+    d["occlusion_rays"] = st.rays.occlusion;
     d["rays"] = st.rays.total();
     d["pixels"] = st.pixels;
     d["pixels_subdivided"] = st.pixels_subdivided;
@@ -418,7 +425,7 @@ PYBIND11_MODULE(whitted, m) {
         py::arg("scene"),
         "Renders the scene with the settings of `whitted render` (keyword arguments named as the scene file's "
         "settings: width, height, camera, aa, aa_threshold, aa_depth, spp, filter, texture_filter, max_depth, min_weight, "
-        "fresnel, specialize, refract_thin, mirror_cutoff, max_exponent, exposure (stops), background, ambient, tile_size, "
+        "fresnel, specialize, refract_thin, mirror_cutoff, max_exponent, exposure (stops), background, ambient, env_occlusion, tile_size, "
         "threads, crop, aov, accel, robust, progress); the scene file's settings fill what is not given");
 
     m.def(

@@ -112,6 +112,13 @@ void add_lighting(CLI::App* render, RenderCommand& c) {
                   "Roughness at which mirror reflection has faded to 0 (see docs/materials.md)")
         ->check(CLI::Range(0.0f, 1.0f))->capture_default_str();
     add_environment_options(g, c.import);
+    g->add_option_function<std::string>(
+         "--env-occlusion",
+         [&rs](const std::string& t) { rs.integrator.env_occlusion = parse_env_occlusion(t, "--env-occlusion"); },
+         "With an environment: directions per point over which the scene occludes its ambient light (a quarter "
+         "as many glossy rays see the scene in rough reflections); off = the ambient unshadowed, the glossy "
+         "term the prefiltered map alone (docs/environment.md)")
+        ->default_str(std::to_string(rs.integrator.env_occlusion));
 }
 
 /// Acceleration: the ray-query backend and its options.

@@ -211,16 +211,16 @@ void print_summary(const RenderCommand& c, const Prepared& p, const FrameResult&
     std::fprintf(stderr,
                  "whitted: wrote %s (%dx%d)\n"
                  "  time   load %.3fs  build %.3fs  render %.3fs  write %.3fs\n"
-                 "  rays   camera %llu  shadow %llu  reflection %llu  refraction %llu  total %llu\n"
+                 "  rays   camera %llu  shadow %llu  reflection %llu  refraction %llu  occlusion %llu  total %llu\n"
                  "  skip   %s; shadow rays not cast: %llu unreached, %llu facing away, %llu with a zero term, "
-                 "%llu too dim; secondary rays below --min-weight %g: %llu\n"
+                 "%llu too dim; occlusion rays too dim: %llu; secondary rays below --min-weight %g: %llu\n"
                  "  speed  %.2f Mrays/s on %d threads\n"
                  "  aa     %s: %.3f camera rays/pixel, %.1f%% pixels subdivided\n",
                  c.output.c_str(), frame.film.width(), frame.film.height(), p.load_seconds, s.build_seconds,
                  s.render_seconds, write_seconds, n(s.rays.camera), n(s.rays.shadow), n(s.rays.reflection),
-                 n(s.rays.refraction), n(s.rays.total()), kernel_name(p.renderer->kernel()).c_str(),
+                 n(s.rays.refraction), n(s.rays.occlusion), n(s.rays.total()), kernel_name(p.renderer->kernel()).c_str(),
                  n(s.rays.shadow_skipped_unreached), n(s.rays.shadow_skipped_facing), n(s.rays.shadow_skipped_zero),
-                 n(s.rays.shadow_skipped_dim), double(c.render.integrator.min_weight),
+                 n(s.rays.shadow_skipped_dim), n(s.rays.occlusion_skipped_dim), double(c.render.integrator.min_weight),
                  n(s.rays.secondary_skipped_cutoff), r.mrays, s.threads, aa_mode_name(c.render.aa.mode), r.per_pixel,
                  100.0 * r.subdivided);
 }

@@ -225,3 +225,17 @@ def test_load_takes_a_material_variant():
     assert whitted.load(box, variant="").info()["text"]
     with pytest.raises(whitted.Error, match="Box.glb.*variant 'beach': the file has no KHR_materials_variants"):
         whitted.load(box, variant="beach")
+
+
+def test_env_occlusion_keyword():
+    # Box under the furnace: occlusion traces rays (off traces none), both give a finite image;
+    # a bad value is a WhittedError naming the keyword.
+    box = os.path.join(ASSETS, "gltf", "Box", "glTF-Binary", "Box.glb")
+    scene = whitted.load(box, environment="furnace")
+    on = whitted.render(scene, width=32, height=32, env_occlusion=16)
+    off = whitted.render(scene, width=32, height=32, env_occlusion="off")
+    assert on.stats["occlusion_rays"] > 0
+    assert off.stats["occlusion_rays"] == 0
+    assert np.isfinite(on.beauty).all()
+    with pytest.raises(whitted.Error, match="env_occlusion"):
+        whitted.render(scene, width=8, env_occlusion="lots")

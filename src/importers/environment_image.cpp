@@ -26,7 +26,7 @@ float srgb_to_linear(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v 
 }  // namespace
 
 const std::vector<std::string>& bundled_environment_names() {
-    static const std::vector<std::string> names{"studio", "city", "courtyard", "forest", "interior", "sunset"};
+    static const std::vector<std::string> names{"studio", "city", "courtyard", "forest", "interior", "sunset", "furnace"};
     return names;
 }
 

@@ -62,6 +62,21 @@ Color parse_color(const std::string& text, const char* what) {
     throw Error(fmt::format("{}: '{}' is not a color (expected r,g,b or a single value)", what, text));
 }
 
+int parse_env_occlusion(const std::string& text, const char* what) {
+    if (text == "off") return 0;
+    size_t used = 0;
+    long v = -1;
+    try {
+        v = std::stol(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used != text.size() || text.empty() || v < 0 || v > kMaxEnvOcclusion)
+        throw Error(fmt::format("{}: '{}' is not off or a number of directions from 0 to {}", what, text,
+                                kMaxEnvOcclusion));
+    return int(v);
+}
+
 AovSet parse_aovs(const std::vector<std::string>& names) {
     AovSet a;
     for (const std::string& n : names) {
@@ -117,6 +132,7 @@ SettingList describe_image_settings(const RenderSettings& rs) {
         {"specialize", flag(in.specialize)},
         {"environment_ambient", flag(in.environment_ambient)},
         {"environment_visible", flag(in.environment_visible)},
+        {"env_occlusion", std::to_string(in.env_occlusion)},
         {"mirror_cutoff", num(rs.mapping.mirror_roughness_cutoff)},
         {"max_exponent", num(rs.mapping.max_exponent)},
         {"refract_thin", flag(rs.mapping.refract_thin)},

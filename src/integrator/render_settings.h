@@ -39,6 +39,10 @@ RenderSettings command_line_render_settings();
 /// "r,g,b" or a single gray value; throws whitted::Error naming `what` (a flag) otherwise.
 Color parse_color(const std::string& text, const char* what);
 
+/// An --env-occlusion value: "off" (or 0) turns occlusion off, an integer 1..kMaxEnvOcclusion is
+/// the directions per point; throws whitted::Error naming `what` otherwise.
+int parse_env_occlusion(const std::string& text, const char* what);
+
 /// AOV names (depth/z, normal/n, albedo, primid, instid, aa_samples, all) as an AovSet; throws
 /// whitted::Error naming the unknown one and the choices.
 AovSet parse_aovs(const std::vector<std::string>& names);

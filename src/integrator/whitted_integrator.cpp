@@ -12,6 +12,7 @@
 #include "integrator/contacts.h"
 #include "shading/local_model.h"
 #include "shading/optics.h"
+#include "shading/sample_sets.h"
 
 namespace whitted {
 
@@ -34,6 +35,48 @@ Color exp_neg(const Color& c) { return {std::exp(-c.x), std::exp(-c.y), std::exp
 
 PrimaryInfo first_hit(const Hit& hit, const Vec3f& N, const WhittedCoeffs& c) {
     return {true, hit.t, N, c.kd + c.kr + c.kt, hit.prim, hit.inst};
+}
+
+/// Ward's adaptive test ("Adaptive Shadow Testing for Ray Tracing", 1991) over n candidates:
+/// potential(j) is what candidate j gives if nothing blocks it (a Color, not negative), test(j) what
+/// arrives through the scene. Candidates are tested from the largest potential down (ties in index
+/// order, so the result does not depend on the sort) until what the untested ones could still add,
+/// times the path weight `weight`, is below `min_weight`; the untested then add their potential
+/// scaled by the fraction the tested ones let through (per channel), or unscaled when none was
+/// tested. Adds everything to `sum` and the untested count to `skipped`; min_weight 0 tests all.
+template <typename Potential, typename Test>
+Color adaptive_test(Color sum, size_t n, Potential potential, Test test, float weight, float min_weight,
+                    uint64_t& skipped) {
+    // The keys are not negative, so their bits order like their values: one integer per candidate,
+    // the key's bits inverted (largest first) above its index.
+    thread_local std::vector<uint64_t> order;
+    order.resize(n);
+    for (size_t j = 0; j < n; ++j) {
+        const float m = max_component(potential(j));
+        const float key = m > 0.f ? m : 0.f;  // -0 and NaN as 0
+        order[j] = uint64_t(~std::bit_cast<uint32_t>(key)) << 32 | uint64_t(j);
+    }
+    std::sort(order.begin(), order.end());
+    auto nth = [&](size_t k) -> const Color& { return potential(uint32_t(order[k])); };
+    Color untested(0.f);
+    for (size_t k = 0; k < n; ++k) untested += nth(k);
+    Color tested(0.f), passed(0.f);
+    size_t i = 0;
+    for (; i < n && weight * max_component(untested) >= min_weight; ++i) {
+        passed += test(uint32_t(order[i]));
+        tested += nth(i);
+        untested = untested - nth(i);
+        untested = Color(std::max(untested.x, 0.f), std::max(untested.y, 0.f), std::max(untested.z, 0.f));
+    }
+    sum += passed;
+    if (i == n) return sum;
+    skipped += n - i;
+    untested = Color(0.f);  // summed again: the running difference above is not exact
+    for (size_t j = i; j < n; ++j) untested += nth(j);
+    if (i == 0) return sum + untested;  // all of them together below min_weight: unblocked
+    const Color let_through(tested.x > 0.f ? passed.x / tested.x : 1.f, tested.y > 0.f ? passed.y / tested.y : 1.f,
+                            tested.z > 0.f ? passed.z / tested.z : 1.f);
+    return sum + untested * let_through;
 }
 
 }  // namespace
@@ -79,9 +122,26 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
     const bool unlit = s.mat.model == MaterialModel::GltfPbr && s.mat.unlit;  // KHR_materials_unlit
     if (!unlit) {
         // I = emission + Ia ka + sum_i Is_i fat_i s_i (kd N.L_i + ks (N.H_i)^n) + kt T + kr R + kg G
-        Color ambient = ambient_light(s.f.N) * c.ka;
+        const Color Ia = ambient_light(s.f.N);
+        Color ambient = Ia * c.ka, behind(0.f);
         if constexpr (K.layers)
-            if (layered) ambient += layered_ambient(s);
+            if (layered) ambient += layered_ambient(s, behind);
+        // The environment's ambient and the roughest glossy terms reach the point only past the scene.
+        Color visible(1.f);
+        if (!m_occlusion.empty()) {
+            // What the terms it scales could give here, whatever the normal: the material's weights
+            // times the brightest irradiance of the ambient.
+            float stake = max_component(c.ka);
+            if (layered) stake += max_component(layers.sheen_ambient);
+            if (depth < m_settings.max_depth) {
+                if (c.roughness >= kGlossyRayRoughness) stake += max_component(c.kg);
+                if (layered && layers.coat_roughness >= kGlossyRayRoughness) stake += layers.coat_kg;
+            }
+            visible = environment_visibility(s, stake * m_ambient_max, counters);
+            ambient *= visible;
+        }
+        if constexpr (K.layers)
+            if (layered) ambient += behind;
         I = direct_light<K>(I + ambient, s, counters);
         if (depth < m_settings.max_depth) {
             Color kt_T(0.f), kr_R(0.f);
@@ -96,9 +156,10 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                 if (layered) kr_R += coat_R;
             }
             // In every kernel: rough opaque scenes cast no mirror rays.
-            Color kg_G = glossy(s, c.kg, layered ? layers.glossy_normal : s.f.N, c.roughness, c.n, counters);
+            Color kg_G = glossy<K>(s, c.kg, layered ? layers.glossy_normal : s.f.N, c.roughness, c.n, visible, counters);
             if (layered && layers.coat_kg > 0.f)
-                kg_G += glossy(s, Color(layers.coat_kg), layers.Nc, layers.coat_roughness, layers.coat_n, counters);
+                kg_G += glossy<K>(s, Color(layers.coat_kg), layers.Nc, layers.coat_roughness, layers.coat_n, visible,
+                                  counters);
             I = I + kt_T + kr_R + kg_G;
         }
     }
@@ -118,12 +179,120 @@ Color WhittedIntegrator::ambient_light(const Vec3f& N) const {
     return m_ambient_sh ? sh9_irradiance(*m_ambient_sh, N) : m_settings.ambient;
 }
 
-Color WhittedIntegrator::layered_ambient(const Shading& s) const {
+Color WhittedIntegrator::layered_ambient(const Shading& s, Color& behind) const {
     const LayerCoeffs& l = *s.layers;
-    Color a(0.f);
-    if (!is_black(l.sheen_ambient)) a += ambient_light(s.f.N) * l.sheen_ambient;
-    if (!is_black(l.kdt)) a += ambient_light(-s.f.N) * l.kdt;  // diffuse transmission: from behind
-    return a;
+    if (!is_black(l.kdt)) behind = ambient_light(-s.f.N) * l.kdt;  // diffuse transmission: from behind
+    return is_black(l.sheen_ambient) ? Color(0.f) : ambient_light(s.f.N) * l.sheen_ambient;
+}
+
+/// The cells of a fixed grid over the cosine-weighted hemisphere about N (the same pattern at every
+/// point, so the image has no noise; SmoothFrame turns it with N), each weighted by the ambient's
+/// radiance from its centre (the SH9, clamped at 0) and tested with an occlusion ray through
+/// transparent occluders, the brightest first (Ward's adaptive test: the untested ones, together
+/// below min_weight, take the tested ones' fraction). A cell whose transmittance differs from a
+/// tested neighbour's lies on an occluder's edge and is traced again at its sub-cells (refine,
+/// below), where its share is worth min_weight: an edge moves across the image in steps of a
+/// sixteenth of a cell.
+/// Directions below the geometric surface (where N leans from Ng) count as unblocked: the surface
+/// does not shadow its own shading hemisphere. Exactly 1 when no ray is blocked.
+Color WhittedIntegrator::environment_visibility(const Shading& s, float stake, RayCounters& counters) const {
+    const float worth = s.weight * stake;
+    if (!(worth >= m_settings.min_weight)) return Color(1.f);  // too dim to matter: unblocked
+    // The budget's n x n cells for a stake of 1 (a white surface under a uniform map of 1), fewer
+    // in proportion below: a cell's share of the stake, the step an occluder's edge makes, stays
+    // the same. The stake is constant over a constant material, so the grid does not change
+    // across it.
+    const float wanted = float(m_settings.env_occlusion) * std::min(worth, 1.f);
+    const size_t n = std::clamp(size_t(std::ceil(std::sqrt(wanted))), std::min<size_t>(2, m_occlusion.size()),
+                                m_occlusion.size());
+    const HemisphereGrid& grid = m_occlusion[n - 1];
+    struct Cell {
+        Color radiance;       // the ambient's radiance from the centre: the cell's weight
+        Color through{-1.f};  // transmittance; negative: not tested
+    };
+    thread_local std::vector<Cell> cells;
+    cells.assign(grid.size(), Cell{});
+    const SmoothFrame frame(s.f.N);
+    const Vec3f org = m_offset.origin(s.f.front ? s.sp.p_shadow : s.sp.p, s.sp.offset_scale, s.f.Ng);
+    auto transmittance = [&](const Vec3f& local) {
+        Ray r;
+        r.org = org;
+        r.dir = frame.to_world(local);
+        r.tfar = kInfinity;
+        if (!(dot(r.dir, s.f.Ng) > 0.f)) return Color(1.f);
+        ++counters.occlusion;
+        return m_accel.transmittance(r);
+    };
+    Color total(0.f);
+    for (size_t k = 0; k < cells.size(); ++k) {
+        const std::array<float, 9> y = sh9_basis(frame.to_world(grid.centres[k]));
+        Color L(0.f);
+        for (size_t i = 0; i < 9; ++i) L += (*m_ambient_sh)[i] * y[i];
+        cells[k].radiance = vmax(L, Color(0.f));
+        total += cells[k].radiance;
+    }
+    if (is_black(total)) return Color(1.f);
+    bool blocked = false;
+    auto test = [&](size_t k) {
+        cells[k].through = transmittance(grid.centres[k]);
+        if (!(cells[k].through == Color(1.f))) blocked = true;
+        return Color(0.f);  // summed below, after the refinement
+    };
+    // The weight that turns a cell's radiance into its share of the stake.
+    const float scale = worth / max_component(total);
+    adaptive_test(Color(0.f), cells.size(), [&](size_t k) -> const Color& { return cells[k].radiance; }, test, scale,
+                  m_settings.min_weight, counters.occlusion_skipped_dim);
+    if (!blocked) return Color(1.f);
+
+    // Refine the cells on an occluder's edge (compared with their neighbours' first transmittance):
+    // the mean of four sub-cells, each again of its four where it differs from a sibling, down to
+    // kOcclusionLevels, wherever the cell's share is still worth min_weight.
+    const float cell = 1.f / float(grid.n);
+    auto differs = [](const Color& a, const Color& b) {
+        const Color d = a - b;
+        return std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)}) > 1.f / 64.f;
+    };
+    auto refine = [&](auto& self, float u0, float v0, float size, int level, float share) -> Color {
+        const float h = 0.5f * size;
+        std::array<Color, 4> t;
+        for (int c = 0; c < 4; ++c)
+            t[c] = transmittance(cosine_direction(u0 + h * (float(c % 2) + 0.5f), v0 + h * (float(c / 2) + 0.5f)));
+        static const int kLevels = getenv("OCC_LEVELS") ? atoi(getenv("OCC_LEVELS")) : kOcclusionLevels;
+        if (level + 1 < kLevels && 0.25f * share >= m_settings.min_weight) {
+            std::array<bool, 4> edge;
+            for (int c = 0; c < 4; ++c) edge[c] = differs(t[c], t[c ^ 1]) || differs(t[c], t[c ^ 2]);
+            for (int c = 0; c < 4; ++c)
+                if (edge[c]) t[c] = self(self, u0 + h * float(c % 2), v0 + h * float(c / 2), h, level + 1, 0.25f * share);
+        }
+        return (t[0] + t[1] + t[2] + t[3]) * 0.25f;
+    };
+    thread_local std::vector<Color> refined;
+    refined.assign(cells.size(), Color(-1.f));
+    for (size_t k = 0; k < cells.size(); ++k) {
+        const Color t = cells[k].through;
+        const float cell_worth = scale * max_component(cells[k].radiance);
+        if (t.x < 0.f || !(cell_worth >= m_settings.min_weight)) continue;
+        bool edge = false;
+        for (const int nb : grid.neighbours(int(k)))
+            if (nb >= 0 && cells[size_t(nb)].through.x >= 0.f && differs(cells[size_t(nb)].through, t)) edge = true;
+        static const int kLevels0 = getenv("OCC_LEVELS") ? atoi(getenv("OCC_LEVELS")) : kOcclusionLevels;
+        if (edge && kLevels0 > 0)
+            refined[k] = refine(refine, float(int(k) % grid.n) * cell, float(int(k) / grid.n) * cell, cell, 0,
+                                cell_worth);
+    }
+    Color tested(0.f), passed(0.f), untested(0.f);
+    for (size_t k = 0; k < cells.size(); ++k) {
+        if (cells[k].through.x < 0.f) {
+            untested += cells[k].radiance;
+            continue;
+        }
+        tested += cells[k].radiance;
+        passed += cells[k].radiance * (refined[k].x >= 0.f ? refined[k] : cells[k].through);
+    }
+    auto ratio = [](float a, float t) { return t > 0.f ? std::clamp(a / t, 0.f, 1.f) : 1.f; };
+    const Color let_through(ratio(passed.x, tested.x), ratio(passed.y, tested.y), ratio(passed.z, tested.z));
+    const Color arrived = passed + untested * let_through;
+    return {ratio(arrived.x, total.x), ratio(arrived.y, total.y), ratio(arrived.z, total.z)};
 }
 
 // ---- Direct light: sum_i Is_i fat_i s_i (kd N.L_i + ks (N.H_i)^n) --------------------------
@@ -149,7 +318,6 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         const Light* light;
         LightSample ls;
         Color potential;  // Is fat (kd N.L + ks (N.H)^n): the light's term if nothing shadows it
-        float key;
         bool behind;      // seen through the surface (diffuse transmission)
     };
     thread_local std::vector<Candidate> environment;
@@ -193,12 +361,11 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
             ++counters.shadow_skipped_zero;
             return;
         }
-        Candidate e{&light, ls, ls.intensity * term, 0.f, behind};
+        const Candidate e{&light, ls, ls.intensity * term, behind};
         if (!light.from_environment) {
             sum += shadowed(e);
             return;
         }
-        e.key = max_component(e.potential);
         environment.push_back(e);
     };
     if constexpr (K.tables) {
@@ -211,37 +378,9 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
     }
     if (environment.empty()) return sum;
 
-    // Brightest first; ties in light order, so the result does not depend on the sort. The keys
-    // are not negative, so their bits order like their values: one integer per candidate, the
-    // key's bits inverted (brightest first) above its index (light order).
-    thread_local std::vector<uint64_t> order;
-    order.resize(environment.size());
-    for (size_t j = 0; j < environment.size(); ++j) {
-        const float key = environment[j].key > 0.f ? environment[j].key : 0.f;  // -0 and NaN as 0
-        order[j] = uint64_t(~std::bit_cast<uint32_t>(key)) << 32 | uint64_t(j);
-    }
-    std::sort(order.begin(), order.end());
-    auto nth = [&](size_t k) -> const Candidate& { return environment[uint32_t(order[k])]; };
-    Color untested(0.f);
-    for (size_t k = 0; k < environment.size(); ++k) untested += nth(k).potential;
-    Color tested(0.f), passed(0.f);
-    size_t i = 0;
-    for (; i < environment.size() && s.weight * max_component(untested) >= m_settings.min_weight; ++i) {
-        const Color through = shadowed(nth(i));
-        passed += through;
-        tested += nth(i).potential;
-        untested = untested - nth(i).potential;
-        untested = Color(std::max(untested.x, 0.f), std::max(untested.y, 0.f), std::max(untested.z, 0.f));
-    }
-    sum += passed;
-    if (i == environment.size()) return sum;
-    counters.shadow_skipped_dim += environment.size() - i;
-    untested = Color(0.f);  // summed again: the running difference above is not exact
-    for (size_t j = i; j < environment.size(); ++j) untested += nth(j).potential;
-    if (i == 0) return sum + untested;  // all of them together below min_weight: unshadowed
-    const Color let_through(tested.x > 0.f ? passed.x / tested.x : 1.f, tested.y > 0.f ? passed.y / tested.y : 1.f,
-                            tested.z > 0.f ? passed.z / tested.z : 1.f);
-    return sum + untested * let_through;
+    return adaptive_test(
+        sum, environment.size(), [&](size_t j) -> const Color& { return environment[j].potential; },
+        [&](size_t j) { return shadowed(environment[j]); }, s.weight, m_settings.min_weight, counters.shadow_skipped_dim);
 }
 
 Color WhittedIntegrator::shadow_factor(const Light& light, const LightSample& ls, const Vec3f& org,
@@ -372,15 +511,96 @@ Color WhittedIntegrator::coat_reflection(const Shading& s, Color& kr, RayCounter
 /// kg G: the split-sum prefilter (Karis 2013) about the mirror direction, the reflection the
 /// mirror term gives up on rough surfaces. The lights extracted from the map already reflect
 /// highlight_share(n) of their light as highlights, so that share of the extracted part is read
-/// from the residual instead of the map. It sees the environment only, never the scene's geometry.
+/// from the residual instead of the map. Without occlusion it sees the environment only; with it,
+/// lobes below kGlossyRayRoughness are traced (glossy_rays) and rougher ones scaled by the
+/// ambient's visibility at the point.
+template <KernelFeatures K>
 Color WhittedIntegrator::glossy(const Shading& s, const Color& kg, const Vec3f& N, float roughness, float n,
-                                RayCounters& counters) const {
+                                const Color& visible, RayCounters& counters) const {
     if (!m_environment || is_black(kg)) return Color(0.f);
     if (!worth_tracing(s.weight * max_component(kg), counters)) return Color(0.f);
     const Vec3f R = mirror_direction(s.f.V, N, s.f.Ng);
-    const Color G = m_environment->prefiltered(R, roughness);
-    if (!m_environment->has_residual()) return kg * G;
-    return kg * lerp(G, m_environment->residual_prefiltered(R, roughness), highlight_share(n));
+    Color G = m_environment->prefiltered(R, roughness);
+    if (m_environment->has_residual()) G = lerp(G, m_environment->residual_prefiltered(R, roughness), highlight_share(n));
+    if (m_glossy_rays == 0) return kg * G;
+    if (roughness >= kGlossyRayRoughness) return kg * (G * visible);
+    return kg * glossy_rays<K>(s, kg, N, roughness, G, counters);
+}
+
+/// The lobe's rays: m_glossy_rays for a glossy weight of 1 (path weight times max(kg)), fewer in
+/// proportion below (so a dielectric's faint glossy term, or one seen in a reflection, costs one
+/// ray, along the mirror direction). Each stands for its N.L-weighted share (the prefilter's
+/// weighting); one whose path weight is below min_weight, or that leaves the scene, takes G, so an
+/// unobstructed lobe gives exactly G. One that hits takes what it hits as seen through the lobe
+/// (seen_in_lobe): a handful of fixed rays cannot resolve sharp detail, so what they find is
+/// shaded smoothly, without recursion.
+template <KernelFeatures K>
+Color WhittedIntegrator::glossy_rays(const Shading& s, const Color& kg, const Vec3f& N, float roughness,
+                                     const Color& G, RayCounters& counters) const {
+    const float stake = s.weight * max_component(kg);
+    const int rays = std::clamp(int(std::ceil(float(m_glossy_rays) * std::min(stake, 1.f))), 1, m_glossy_rays);
+    const float alpha = std::max(roughness * roughness, 1e-3f);
+    const SmoothFrame frame(N);
+    std::array<std::pair<Vec3f, float>, kMaxGlossyRays> lobe;  // direction, N.L
+    size_t used = 0;
+    float total = 0.f;
+    for (int j = 0; j < rays; ++j) {
+        Vec3f L = mirror_direction(s.f.V, N, s.f.Ng);
+        if (rays > 1) {
+            const Vec3f H = frame.to_world(ggx_half_vector((float(j) + 0.5f) / float(rays), radical_inverse2(uint32_t(j)), alpha));
+            const float v_h = dot(s.f.V, H);
+            if (!(v_h > 0.f)) continue;
+            L = normalize(H * (2.f * v_h) - s.f.V);
+        }
+        const float n_l = dot(N, L);
+        if (!(n_l > 0.f) || !(dot(L, s.f.Ng) > 0.f)) continue;  // below the surface: no light from there
+        lobe[used++] = {L, n_l};
+        total += n_l;
+    }
+    if (!(total > 0.f)) return G;
+    const RayCone cone{s.secondary.width, std::max(s.secondary.spread, 2.f * alpha / std::sqrt(float(used)))};
+    Color sum(0.f);
+    float missed = 0.f;
+    bool hit_any = false;
+    for (size_t j = 0; j < used; ++j) {
+        const auto& [L, n_l] = lobe[j];
+        const float w = stake * (n_l / total);
+        if (!worth_tracing(w, counters)) {
+            missed += n_l;
+            continue;
+        }
+        const Ray r = spawn_ray(m_offset, s.sp, s.f.Ng, L);
+        count(counters, RayKind::Reflection);
+        const Hit hit = m_accel.intersect(r, RayKind::Reflection);
+        if (!hit.valid()) {
+            missed += n_l;
+            continue;
+        }
+        hit_any = true;
+        sum += seen_in_lobe(r, hit, cone, roughness) * n_l;
+    }
+    if (!hit_any) return G;
+    return (sum + G * missed) / total;
+}
+
+/// A surface met by a glossy ray, shaded as a rough reflection can see it (path regularisation,
+/// Kaplanyan & Dachsbacher 2013): its emission, its diffuse response to the environment unshadowed
+/// (the ambient's SH9 times ka, the extracted lights' SH9 times kd), its specular and mirror
+/// reflection of the map prefiltered at no less than the lobe's roughness, and what it transmits
+/// straight through as the map blurred the same way. No shadow, highlight or secondary ray: the
+/// sparkle of a neighbour's highlights and mirror images would otherwise show once per glossy ray.
+Color WhittedIntegrator::seen_in_lobe(const Ray& ray, const Hit& hit, const RayCone& cone, float roughness) const {
+    const SurfacePoint sp = m_view.surface(ray, hit, cone);
+    const ShadingFrame f = shading_frame(sp, ray.dir);
+    const WhittedCoeffs c = m_view.coefficients(sp);
+    const Material& mat = m_view.scene().materials[sp.material];
+    if (mat.model == MaterialModel::GltfPbr && mat.unlit) return sanitize(c.emission);
+    Color L = c.emission + ambient_light(f.N) * c.ka + sh9_irradiance(m_lights_sh, f.N) * c.kd;
+    const Color specular = c.kr + c.kg;
+    if (!is_black(specular))
+        L += specular * m_environment->prefiltered(mirror_direction(f.V, f.N, f.Ng), std::max(c.roughness, roughness));
+    if (!is_black(c.kt)) L += c.kt * m_environment->prefiltered(ray.dir, roughness);
+    return sanitize(L);
 }
 
 // ---- Media and coverage: absorption, alpha blend ------------------------------------------------
@@ -539,6 +759,28 @@ WhittedIntegrator::WhittedIntegrator(const SceneView& view, const Accelerator& a
     m_environment = view.environment();
     const std::optional<Environment>& env = view.scene().environment;
     if (env && env->ambient_sh && settings.environment_ambient) m_ambient_sh = &*env->ambient_sh;
+    if (m_ambient_sh && settings.env_occlusion > 0) {
+        const int n = std::max(1, int(std::lround(std::sqrt(double(settings.env_occlusion)))));
+        for (int k = 1; k <= n; ++k) m_occlusion.push_back(cosine_grid(k * k));
+        // The ambient's brightest irradiance: over a Fibonacci sphere of normals (the SH9 is smooth).
+        constexpr int kNormals = 512;
+        for (int i = 0; i < kNormals; ++i) {
+            const float y = 1.f - 2.f * (float(i) + 0.5f) / float(kNormals), r = std::sqrt(std::max(0.f, 1.f - y * y));
+            const float phi = 2.39996323f * float(i);
+            m_ambient_max = std::max(m_ambient_max,
+                                     max_component(sh9_irradiance(*m_ambient_sh, Vec3f(r * std::cos(phi), y, r * std::sin(phi)))));
+        }
+    }
+    if (m_environment) {
+        m_glossy_rays = glossy_ray_count(settings.env_occlusion);
+        // The extracted lights as radiance SH9 (each a delta of power pi I at its direction), for
+        // the diffuse light of what glossy rays find.
+        for (const Light& l : view.scene().lights) {
+            if (!l.from_environment) continue;
+            const std::array<float, 9> y = sh9_basis(-normalize(Vec3f(l.direction)));
+            for (size_t k = 0; k < 9; ++k) m_lights_sh[k] += l.color * (l.intensity * kPi * y[k]);
+        }
+    }
     if (m_kernel.transmission) {
         m_contacts = DielectricContacts::find(view);
         m_covers = OpaqueCovers::find(view);

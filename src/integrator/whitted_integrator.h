@@ -10,9 +10,11 @@
 // smallest instantiation its scene needs, so the hot path carries no per-ray feature branches.
 #pragma once
 
+#include <algorithm>
 #include <memory>
 #include <optional>
 #include <span>
+#include <vector>
 
 #include "accel/accelerator.h"
 #include "core/ray_offset.h"
@@ -21,8 +23,23 @@
 #include "integrator/scene_view.h"
 #include "integrator/shading_frame.h"
 #include "shading/light_sample.h"
+#include "shading/sample_sets.h"
 
 namespace whitted {
+
+/// Default of --env-occlusion: directions per shading point over which the environment's ambient
+/// is occluded (docs/environment.md, "Occlusion"); the glossy rays are a quarter of it.
+constexpr int kDefaultEnvOcclusion = 36;
+/// Levels of sub-cells an occlusion cell on an occluder's edge is refined into (2: 16 sub-cells).
+constexpr int kOcclusionLevels = 2;
+/// Glossy reflection rougher than this takes the prefiltered map times the ambient's visibility
+/// instead of rays over its lobe.
+constexpr float kGlossyRayRoughness = 0.6f;
+/// Glossy rays over a lobe for an --env-occlusion budget (a quarter, at least 1; 0 for 0).
+constexpr int kMaxGlossyRays = 64;
+constexpr int glossy_ray_count(int budget) { return budget <= 0 ? 0 : std::clamp(budget / 4, 1, kMaxGlossyRays); }
+/// Largest --env-occlusion budget.
+constexpr int kMaxEnvOcclusion = 1024;
 
 struct IntegratorSettings {
     int max_depth = 5;                 ///< maximum depth of the ray tree (camera ray = depth 0)
@@ -37,6 +54,9 @@ struct IntegratorSettings {
                                        ///< false (an `ambient` given): the constant `ambient`
     bool environment_visible = true;   ///< camera rays that miss see the environment; false (a `background`
                                        ///< given, or the environment's `visible` false): the background
+    int env_occlusion = kDefaultEnvOcclusion;  ///< with an environment: directions per point that occlude its
+                                       ///< ambient, and 4 times the glossy rays over a rough lobe; 0 = off
+                                       ///< (the ambient unshadowed, the glossy term the prefiltered map alone)
 };
 
 class DielectricContacts;
@@ -114,8 +134,15 @@ private:
     Color missed(const Ray& ray, int depth, const RayCone& cone) const;
     /// Ia at the hit: the environment's ambient light in the direction of N, or the constant.
     Color ambient_light(const Vec3f& N) const;
-    /// The layers' ambient terms: the sheen lobe's albedo and diffuse transmission from behind.
-    Color layered_ambient(const Shading& s) const;
+    /// The layers' ambient terms: the sheen lobe's albedo (returned) and diffuse transmission from
+    /// behind (`behind`).
+    Color layered_ambient(const Shading& s, Color& behind) const;
+    /// The share of the environment's ambient that reaches the point past the scene, per channel
+    /// (1 = nothing in the way): a grid of m_occlusion about N, each cell weighted by the ambient's
+    /// radiance from it and tested adaptively (Ward 1991), the cells on an occluder's edge refined.
+    /// `stake`: the most the terms it scales can give at this point and material (any normal), which
+    /// sets the grid's size and bounds the error of what is not traced.
+    Color environment_visibility(const Shading& s, float stake, RayCounters& counters) const;
     template <KernelFeatures K>
     Color direct_light(Color sum, const Shading& s, RayCounters& counters) const;
     template <KernelFeatures K>
@@ -127,9 +154,18 @@ private:
     template <KernelFeatures K>
     Color coat_reflection(const Shading& s, Color& kr, RayCounters& counters) const;
     /// kg G: the environment prefiltered by `roughness` about V mirrored on N (0 without an
-    /// environment); no ray is traced, so it sees no geometry. n: the lobe's highlight exponent.
-    Color glossy(const Shading& s, const Color& kg, const Vec3f& N, float roughness, float n,
+    /// environment). n: the lobe's highlight exponent. With occlusion on, rays over the lobe
+    /// below kGlossyRayRoughness (glossy_rays), above it the map times `visible`.
+    template <KernelFeatures K>
+    Color glossy(const Shading& s, const Color& kg, const Vec3f& N, float roughness, float n, const Color& visible,
                  RayCounters& counters) const;
+    /// G seen through the scene: GGX half vectors about N (a fixed Hammersley set), each reflected
+    /// ray traced, what it hits shaded by seen_in_lobe, `G` (the prefiltered map) where it leaves.
+    template <KernelFeatures K>
+    Color glossy_rays(const Shading& s, const Color& kg, const Vec3f& N, float roughness, const Color& G,
+                      RayCounters& counters) const;
+    /// What a glossy ray that hit sees there, shaded smoothly (no shadow, highlight or recursion).
+    Color seen_in_lobe(const Ray& ray, const Hit& hit, const RayCone& cone, float roughness) const;
     /// kt T split per channel through a dispersive surface (KHR_materials_dispersion).
     template <KernelFeatures K>
     Color dispersed(const Shading& s, const Ray& t, const Color& kt, const Color& kt_through, float other_eta, float w,
@@ -171,6 +207,11 @@ private:
     KernelFeatures m_kernel;
     const EnvironmentMap* m_environment = nullptr;             ///< null: misses see the background
     const std::array<Color, 9>* m_ambient_sh = nullptr;        ///< null: the constant ambient
+    std::vector<HemisphereGrid> m_occlusion;  ///< n x n cells of the cosine-weighted hemisphere for n = 1, 2, ..;
+                                          ///< empty: the ambient is not occluded
+    float m_ambient_max = 0.f;            ///< largest channel of the ambient's irradiance over all normals
+    int m_glossy_rays = 0;                ///< rays over a glossy lobe of weight 1; 0: the prefiltered map alone
+    std::array<Color, 9> m_lights_sh{};   ///< the extracted lights as radiance SH9 (seen_in_lobe)
     TraceFn m_trace = nullptr;          ///< trace<m_kernel>
     CameraFn m_trace_camera = nullptr;  ///< trace_camera<m_kernel>
     std::shared_ptr<const DielectricContacts> m_contacts;  ///< null when no dielectrics touch

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/fp_mode.h"
 #include "core/parallel.h"
+#include "shading/sample_sets.h"
 
 namespace whitted {
 
@@ -150,16 +151,6 @@ Color residual_texel(const Color& c, double lum, double threshold) {
     return lum > threshold ? c * float(threshold / lum) : c;
 }
 
-/// Radical inverse in base 2 (van der Corput), the second Hammersley coordinate.
-float radical_inverse2(uint32_t k) {
-    k = (k << 16u) | (k >> 16u);
-    k = ((k & 0x55555555u) << 1u) | ((k & 0xAAAAAAAAu) >> 1u);
-    k = ((k & 0x33333333u) << 2u) | ((k & 0xCCCCCCCCu) >> 2u);
-    k = ((k & 0x0F0F0F0Fu) << 4u) | ((k & 0xF0F0F0F0u) >> 4u);
-    k = ((k & 0x00FF00FFu) << 8u) | ((k & 0xFF00FF00u) >> 8u);
-    return float(k) * 2.3283064365386963e-10f;
-}
-
 /// A region of the median cut: texels [x0, x1) x [y0, y1) and their energy.
 struct Region {
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
@@ -260,15 +251,6 @@ std::vector<Region> median_cut(const SummedArea& sat, int width, int height, int
     return regions;
 }
 
-/// Orthonormal tangents of unit n (Duff et al. 2017, branchless).
-void tangent_frame(const Vec3f& n, Vec3f& t, Vec3f& b) {
-    const float sign = std::copysign(1.f, n.z);
-    const float a = -1.f / (sign + n.z);
-    const float c = n.x * n.y * a;
-    t = {1.f + sign * n.x * n.x * a, sign * c, -sign * n.x};
-    b = {c, sign + n.y * n.y * a, -n.y};
-}
-
 /// The GGX prefilter of a pyramid, one lat-long per kPrefilterRoughness, by filtered importance
 /// sampling (Krivanek & Colbert 2008): a fixed Hammersley set per texel, each sample read from the
 /// MIP level whose texel matches its solid angle.
@@ -305,14 +287,13 @@ std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::L
         for (int s = 0; s < kPrefilterSamples; ++s) {
             // GGX half vector (normal = view = n), its reflection l, pdf(l) = D(h) / 4.
             const float xi1 = (float(s) + 0.5f) / float(kPrefilterSamples), xi2 = radical_inverse2(uint32_t(s));
+            const Vec3f h = ggx_half_vector(xi1, xi2, alpha);
             const float cos2 = (1.f - xi1) / (1.f + (a2 - 1.f) * xi1);
-            const float cos_h = std::sqrt(cos2), sin_h = std::sqrt(std::max(0.f, 1.f - cos2));
-            const float phi = 2.f * kPi * xi2;
             const float denom = cos2 * (a2 - 1.f) + 1.f;
             const float pdf = a2 / (kPi * denom * denom) * 0.25f;
             const float sample_sr = 1.f / (float(kPrefilterSamples) * pdf);
             const float lod = std::max(0.f, 0.5f * std::log2(sample_sr / float(texel_sr)) + 1.f);
-            samples[k].push_back({sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h, lod});
+            samples[k].push_back({h.x, h.y, h.z, lod});
         }
     }
     pool.for_each(rows.size(), [&](size_t item, int) {

@@ -29,7 +29,8 @@ TEST(BenchEnvCli, CsvColumnsReferenceRowAndAListedDefault) {
     const fs::path out = whitted::test::scratch_dir("whitted_bench_env_cli", "sweep");
     const Result r = run("bench env '" + kBox + "' --maps studio --lights 0,16 --reference 16 --width 24 --repeat 1 "
                          "--threads 1 --overhead-scenes '" + kScene + "' --overhead-repeat 1 --split-maps studio,courtyard "
-                         "--split-counts 4,16 --split-normals 8 --no-plot --out '" +
+                         "--split-counts 4,16 --split-normals 8 --occlusion 0,4 --occlusion-reference 16 --occlusion-maps furnace "
+                         "--no-plot --out '" +
                          out.string() + "'");
     ASSERT_EQ(r.code, 0) << r.out << r.err;
 
@@ -71,6 +72,23 @@ TEST(BenchEnvCli, CsvColumnsReferenceRowAndAListedDefault) {
     EXPECT_EQ(overhead[0].at("scene"), "whitted1980");
     EXPECT_TRUE(std::isfinite(num(overhead[0], "ratio")));
     EXPECT_EQ(overhead[0].at("plain_total_rays"), overhead[0].at("env_total_rays"));  // lookups only, no extra ray
+
+    // The occlusion sweep: the generated scene and default.glb under the furnace, budgets 0, 4 and
+    // the reference 16; off traces no occlusion ray, the reference matches itself.
+    EXPECT_TRUE(fs::exists(out / "occlusion.glb"));
+    const std::vector<Row> occ = read_csv(out / "env_occlusion.csv", &header);
+    for (const char* column : {"scene", "map", "budget", "psnr_display", "mean_ratio", "psnr_previous", "seconds",
+                               "occlusion_rays"})
+        EXPECT_NE(std::find(header.begin(), header.end(), column), header.end()) << column;
+    ASSERT_EQ(occ.size(), 6u);
+    EXPECT_EQ(occ[0].at("scene"), "occlusion");
+    EXPECT_EQ(occ[3].at("scene"), "default");
+    EXPECT_EQ(occ[0].at("budget"), "0");
+    EXPECT_EQ(num(occ[0], "occlusion_rays"), 0.0);
+    EXPECT_GT(num(occ[1], "occlusion_rays"), 0.0);
+    EXPECT_EQ(occ[2].at("psnr_display"), "inf");
+    EXPECT_LT(num(occ[0], "psnr_display"), num(occ[1], "psnr_display"));  // occlusion off is the farthest
+    EXPECT_NE(r.out.find("chosen: "), std::string::npos) << r.out;
 
     // The split alone: a cost row per map, an error row per threshold rule and count (8 rules with the
     // ambient correction, the default rule without), errors finite and the default rule's small.

@@ -52,6 +52,16 @@ TEST(Cli, BadFlagValueIsOneLineAndExitTwo) {
     EXPECT_EQ(line_count(r.err), 1u) << r.err;
 }
 
+// --env-occlusion takes off or a number of directions; anything else is one line naming the flag.
+TEST(Cli, EnvOcclusionTakesOffOrACount) {
+    for (const char* bad : {"5x", "2000", "-1", ""}) {
+        const Result r = run("render '" + kBox + "' -o /dev/null --env-occlusion '" + bad + "'");
+        EXPECT_NE(r.code, 0) << bad;
+        EXPECT_EQ(line_count(r.err), 1u) << r.err;
+        EXPECT_NE(r.err.find("--env-occlusion"), std::string::npos) << r.err;
+    }
+}
+
 // `bench stability --accels` names backends of the self-intersection sweep: an unknown one is a
 // one-line error, not an empty table.
 TEST(Cli, BenchStabilityUnknownBackendIsOneLineAndExitTwo) {

@@ -17,23 +17,12 @@
 #include "integrator/render.h"
 #include "scene/scene_builder.h"
 #include "shading/environment_map.h"
+#include "tests/support/environment_scenes.h"
 
 namespace whitted {
 namespace {
 
 namespace fs = std::filesystem;
-
-/// A lat-long of constant radiance L.
-Environment constant_environment(Color L) {
-    auto image = std::make_shared<EnvironmentImage>();
-    image->name = "constant";
-    image->width = 64;
-    image->height = 32;
-    image->texels.assign(64 * 32, L);
-    Environment env;
-    env.image = image;
-    return env;
-}
 
 /// One unit sphere at the origin of material `m`, seen from +Z, under `env`.
 Scene sphere_under(const Material& m, const Environment& env, int env_lights) {
@@ -45,10 +34,7 @@ Scene sphere_under(const Material& m, const Environment& env, int env_lights) {
     s.materials.push_back(m);
     s.spheres.push_back(sphere);
     s.cameras.push_back(make_camera(CameraType::Perspective, {0, 0, 4}, {0, 0, -1}, {0, 1, 0}, 0.7));
-    s.environment = env;
-    ImportOptions io;
-    io.environment_lights = env_lights;
-    setup_environment(s, io);
+    test::light_with(s, env, env_lights);
     return s;
 }
 
@@ -60,27 +46,11 @@ Scene sphere_under(const WhittedCoeffs& c, const Environment& env, int env_light
     return sphere_under(m, env, env_lights);
 }
 
-/// A glTF metal of base colour `base` and roughness `roughness`.
-Material gltf_metal(Color base, float roughness) {
-    Material m;
-    m.model = MaterialModel::GltfPbr;
-    m.base_color = Vec4f(base, 1.f);
-    m.metallic = 1.f;
-    m.roughness = roughness;
-    return m;
-}
+Film render(const Scene& scene, const IntegratorSettings& integrator = {}) { return test::render_square(scene, integrator); }
 
-Film render(const Scene& scene, const IntegratorSettings& integrator = {}) {
-    RenderSettings rs;
-    rs.width = rs.height = 32;
-    rs.threads = 1;
-    rs.integrator = integrator;
-    return Renderer(scene, rs).render();
-}
-
-void expect_near_rel(const Color& got, const Color& want, float rel) {
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], want[k], rel * want[k]) << "channel " << k;
-}
+using test::constant_environment;
+using test::expect_near_rel;
+using test::gltf_metal;
 
 // A white diffuse sphere (kd = ka = 1) under a constant environment of radiance L has radiance L:
 // it vanishes against the background, whether the light is all ambient or partly extracted.
@@ -148,6 +118,7 @@ TEST(EnvironmentRender, DimLightsSkippedWithinMinWeight) {
     RenderSettings rs;
     rs.width = rs.height = 32;
     rs.threads = 1;
+    rs.integrator.env_occlusion = 0;  // the lights' shadow test alone (occlusion: test_environment_occlusion.cpp)
     RenderStats exact_stats, cut_stats;
     const Film a = Renderer(scene, rs).render(&exact_stats);
     rs.integrator.min_weight = 1.f / 255.f;
