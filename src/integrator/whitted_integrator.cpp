@@ -257,8 +257,7 @@ Color WhittedIntegrator::environment_visibility(const Shading& s, float stake, R
         std::array<Color, 4> t;
         for (int c = 0; c < 4; ++c)
             t[c] = transmittance(cosine_direction(u0 + h * (float(c % 2) + 0.5f), v0 + h * (float(c / 2) + 0.5f)));
-        static const int kLevels = getenv("OCC_LEVELS") ? atoi(getenv("OCC_LEVELS")) : kOcclusionLevels;
-        if (level + 1 < kLevels && 0.25f * share >= m_settings.min_weight) {
+        if (level + 1 < kOcclusionLevels && 0.25f * share >= m_settings.min_weight) {
             std::array<bool, 4> edge;
             for (int c = 0; c < 4; ++c) edge[c] = differs(t[c], t[c ^ 1]) || differs(t[c], t[c ^ 2]);
             for (int c = 0; c < 4; ++c)
@@ -275,8 +274,7 @@ Color WhittedIntegrator::environment_visibility(const Shading& s, float stake, R
         bool edge = false;
         for (const int nb : grid.neighbours(int(k)))
             if (nb >= 0 && cells[size_t(nb)].through.x >= 0.f && differs(cells[size_t(nb)].through, t)) edge = true;
-        static const int kLevels0 = getenv("OCC_LEVELS") ? atoi(getenv("OCC_LEVELS")) : kOcclusionLevels;
-        if (edge && kLevels0 > 0)
+        if (edge)
             refined[k] = refine(refine, float(int(k) % grid.n) * cell, float(int(k) / grid.n) * cell, cell, 0,
                                 cell_worth);
     }
