@@ -22,6 +22,7 @@
 #include "accel/factory/create_accelerator.h"
 #include "core/fp_mode.h"
 #include "core/ray_offset.h"
+#include "integrator/contacts.h"
 #include "integrator/camera.h"
 #include "integrator/scene_view.h"
 #include "integrator/shading_frame.h"
@@ -805,13 +806,24 @@ namespace {
 class BoundTracer {
 public:
     BoundTracer(const SceneView& view, const Accelerator& accel, const IntegratorSettings& s)
-        : m_view(view), m_accel(accel), m_offset(accel.ray_offset()), m_s(s) {}
+        : m_view(view), m_accel(accel), m_offset(accel.ray_offset()), m_s(s), m_covers(OpaqueCovers::find(view)) {}
 
     Color trace(const Ray& ray, RayKind kind, int depth, const RayCone& cone, float weight) const {
-        const Hit hit = m_accel.intersect(ray, kind);
+        Hit hit = m_accel.intersect(ray, kind);
         if (!hit.valid()) return m_s.background;
         const Scene& scene = m_view.scene();
-        const SurfacePoint sp = m_view.surface(ray, hit, cone);
+        SurfacePoint sp = m_view.surface(ray, hit, cone);
+        // shade()'s rule: an opaque surface under a transmissive one lying on it is what the ray sees
+        // (a glass resting on a floor), so the tree does not pass through the floor below it.
+        if (m_covers && m_covers->candidate(object_index(scene, hit.geom, hit.inst))) {
+            RayCounters unused;
+            Hit cover = m_covers->at(sp.p, sp.offset_scale, sp.ng, unused);
+            if (cover.valid()) {
+                cover.t = hit.t;
+                hit = cover;
+                sp = m_view.surface(ray, hit, cone);
+            }
+        }
         const RayCone secondary{cone.width_at(hit.t), cone.spread};
         const Material& mat = scene.materials[sp.material];
         const WhittedCoeffs c = m_view.coefficients(sp);
@@ -863,6 +875,7 @@ private:
     const Accelerator& m_accel;
     RayOffsetPolicy m_offset;  ///< m_accel's, as the integrator keeps it
     IntegratorSettings m_s;
+    std::shared_ptr<const OpaqueCovers> m_covers;  ///< as the integrator finds them (null: none)
 };
 
 }  // namespace
