@@ -161,6 +161,13 @@ void time_interleaved(std::vector<Timed*> batch, int repeat, double budget, bool
             if (round == 0 || budget <= 0.0 || t->spent < budget) t->run(cpu_timing);
 }
 
+/// time_interleaved over every scene of `timed`, with the sweeps' 2 s budget per scene.
+void time_all(std::vector<Timed>& timed, int repeat, bool cpu_timing) {
+    std::vector<Timed*> batch;
+    for (Timed& t : timed) batch.push_back(&t);
+    time_interleaved(batch, repeat, 2.0, cpu_timing);
+}
+
 /// What one N measured on one asset and map.
 struct Row {
     std::string asset, map;
@@ -225,9 +232,7 @@ std::vector<Row> light_sweep(const BenchEnvOptions& o, const std::vector<int>& c
             std::printf("== %s / %s: %dx%d, %zu triangles, %s, %s time, load %.2f\n", label_of(asset).c_str(),
                         map.c_str(), size.width, size.height, timed.front().scene->instanced_triangle_count(),
                         o.aa.c_str(), cpu_timing ? "process CPU" : "wall", load_average_1min());
-            std::vector<Timed*> batch;
-            for (Timed& t : timed) batch.push_back(&t);
-            time_interleaved(batch, o.repeat, 2.0, cpu_timing);
+            time_all(timed, o.repeat, cpu_timing);
 
             const size_t ref_index = size_t(std::find(counts.begin(), counts.end(), o.reference) - counts.begin());
             const std::vector<float> ref_linear = packed_rgb(timed[ref_index].film);
@@ -400,9 +405,7 @@ void occlusion_sweep(const BenchEnvOptions& o, const fs::path& out) {
             const ImageSize size = timed.front().renderer->image_size();
             std::printf("== occlusion: %s / %s: %dx%d, %s, %s time, load %.2f\n", label_of(path).c_str(), map.c_str(),
                         size.width, size.height, o.aa.c_str(), cpu_timing ? "process CPU" : "wall", load_average_1min());
-            std::vector<Timed*> batch;
-            for (Timed& t : timed) batch.push_back(&t);
-            time_interleaved(batch, o.repeat, 2.0, cpu_timing);
+            time_all(timed, o.repeat, cpu_timing);
             const size_t ref_index = size_t(std::find(budgets.begin(), budgets.end(), o.occlusion_reference) - budgets.begin());
             const std::vector<float> ref_linear = packed_rgb(timed[ref_index].film);
             const std::vector<float> ref_display = display_rgb(ref_linear, display);
@@ -416,11 +419,12 @@ void occlusion_sweep(const BenchEnvOptions& o, const fs::path& out) {
                 r.scene = label_of(path);
                 r.map = map;
                 r.budget = budgets[k];
-                const std::vector<float> disp = display_rgb(packed_rgb(t.film), display);
+                const std::vector<float> linear = packed_rgb(t.film);
+                const std::vector<float> disp = display_rgb(linear, display);
                 const double e = rmse(disp, ref_display);
                 r.psnr = psnr_of(e);
                 r.rmse_codes = e / kOneCode;
-                r.mean_ratio = ref_mean > 0.0 ? mean_of(packed_rgb(t.film)) / ref_mean : 1.0;
+                r.mean_ratio = ref_mean > 0.0 ? mean_of(linear) / ref_mean : 1.0;
                 r.psnr_previous = previous.empty() ? 0.0 : psnr_of(rmse(disp, previous));
                 r.seconds = t.seconds(cpu_timing);
                 r.stats = t.stats;
