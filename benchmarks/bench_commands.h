@@ -27,6 +27,8 @@ Command register_bench_env(CLI::App& bench);
 Command register_bench_materials(CLI::App& bench);
 /// `whitted bench process`: whole runs, start to file written, with their split (bench_process.cpp).
 Command register_bench_process(CLI::App& bench);
+/// `whitted bench quadrics`: analytic cylinders, cones and discs against tessellated ones (bench_quadrics.cpp).
+Command register_bench_quadrics(CLI::App& bench);
 /// `whitted bench scale`: load/build/render time and memory per object against object count (bench_scale.cpp).
 Command register_bench_scale(CLI::App& bench);
 /// `whitted bench skip`: what specialised kernels and skipped rays save (bench_skip.cpp).

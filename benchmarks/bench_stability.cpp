@@ -37,7 +37,7 @@ struct BenchStabilityOptions {
     uint64_t watertight_rays = 10'000'000;  ///< per backend and mesh (split over 3 aim kinds)
     size_t points = 4000;                   ///< self-intersection surface points per case
     int threads = 0;                        ///< 0 = all cores
-    std::string sections = "all";           ///< comma list: self,images,watertight,energy,refraction,deep,hiterror
+    std::string sections = "all";           ///< comma list: self,images,watertight,energy,refraction,deep,hiterror,quadrics
     std::vector<float> offset_ulps;         ///< self: sweep these offsets instead of the standard variants
     bool skip_origin = false;               ///< self: queries skip the origin's own primitive (experiment)
     bool double_origin = false;             ///< self: --offset-ulps from the double hit point, directed rounding
@@ -375,6 +375,44 @@ void run_hit_error(const BenchStabilityOptions& o, Csv& csv) {
                 }
 }
 
+// ---- 8. analytic quadrics ---------------------------------------------------------------------
+void run_quadrics(const BenchStabilityOptions& o, Csv& csv) {
+    std::printf("\n## 8. Analytic quadrics: self-hits, leaks and hit-point error (%zu points per case, 8 directions per kind)\n\n"
+                "| backend | quadric | scale | translation | points | self-hits out/in/shadow | leaks | lost hits | "
+                "inward unjudged | median ulp | max ulp | max ulp off the surface | max normal error (rad) |\n"
+                "|---|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n",
+                o.points);
+    for (const char* accel : {"bvh", "embree"})
+        for (const QuadricKind kind : {QuadricKind::Cylinder, QuadricKind::Cone, QuadricKind::Disc})
+            for (double t : kTranslations)
+                for (double s : kScales) {
+                    if (!(s >= 16.0 * double(ulp(float(t + s))))) continue;
+                    QuadricProbeConfig c;
+                    c.accel = accel;
+                    c.kind = kind;
+                    c.scale = s;
+                    c.translation = t;
+                    c.points = o.points;
+                    QuadricProbeResult r = probe_quadric(c);
+                    const Distribution u = distribution(r.point_error_ulps), n = distribution(r.normal_error_rad),
+                                       off = distribution(r.surface_error_ulps);
+                    const char* subject = kind == QuadricKind::Cylinder ? "capped cylinder" : kind == QuadricKind::Cone ? "capped cone" : "disc";
+                    for (auto [metric, value] : std::initializer_list<std::pair<const char*, double>>{
+                             {"points", double(r.points)}, {"self_hits_out", double(r.self_hits[0])},
+                             {"self_hits_in", double(r.self_hits[1])}, {"self_hits_shadow", double(r.self_hits[2])},
+                             {"leaks", double(r.leaks)}, {"lost_hits", double(r.camera_misses)},
+                             {"inward_unjudged", double(r.inward_unjudged)}, {"max_off_surface_ulp", off.max},
+                             {"median_ulp", u.median},
+                             {"max_ulp", u.max}, {"max_normal_rad", n.max}})
+                        csv.row("quadrics", accel, subject, s, t, metric, value);
+                    std::printf("| %s | %s | %g | %g | %llu | %llu/%llu/%llu | %llu | %llu | %llu | %.2f | %.2f | %.2f | %.1e |\n", accel,
+                                subject, s, t, (unsigned long long)r.points, (unsigned long long)r.self_hits[0],
+                                (unsigned long long)r.self_hits[1], (unsigned long long)r.self_hits[2], (unsigned long long)r.leaks,
+                                (unsigned long long)r.camera_misses, (unsigned long long)r.inward_unjudged, u.median, u.max, off.max,
+                                n.max);
+                }
+}
+
 int run_bench_stability(BenchStabilityOptions o) {
     if (o.quick) {
         o.watertight_rays = std::min<uint64_t>(o.watertight_rays, 300000);
@@ -392,6 +430,7 @@ int run_bench_stability(BenchStabilityOptions o) {
     if (wanted(o, "refraction")) run_refraction(csv);
     if (wanted(o, "deep")) run_deep(csv);
     if (wanted(o, "hiterror")) run_hit_error(o, csv);
+    if (wanted(o, "quadrics")) run_quadrics(o, csv);
     std::printf("\nwrote %s in %.0f s\n", (out / "stability.csv").c_str(),
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     return 0;
@@ -425,7 +464,7 @@ Command register_bench_stability(CLI::App& bench) {
     app->add_flag("--double-origin", o->double_origin,
                   "Self-intersection experiment: --offset-ulps origins formed in double from the double hit point and "
                   "rounded away from the surface");
-    app->add_option("--sections", o->sections, "Comma list of self,images,watertight,energy,refraction,deep,hiterror or all")
+    app->add_option("--sections", o->sections, "Comma list of self,images,watertight,energy,refraction,deep,hiterror,quadrics or all")
         ->capture_default_str();
     return Command{app, [o] { return run_bench_stability(*o); }};
 }

@@ -12,12 +12,14 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <random>
 #include <utility>
 #include <cstdio>
 #include <cstdlib>
 
+#include "accel/common/quadric.h"
 #include "accel/common/sphere.h"
 #include "accel/factory/create_accelerator.h"
 #include "core/fp_mode.h"
@@ -714,6 +716,160 @@ HitErrorResult probe_hit_error(const std::string& accel_name, bool sphere, doubl
         const double mag = std::max({std::fabs(exact.x), std::fabs(exact.y), std::fabs(exact.z)});
         res.rel_error.push_back(err / mag);
         res.ulp_error.push_back(err / double(ulp(float(mag))));
+    }
+    return res;
+}
+
+// ---------------------------------------------------------------------------------------------
+// 8. Analytic quadrics
+
+QuadricProbeResult probe_quadric(const QuadricProbeConfig& cfg) {
+    const ScopedFlushDenormals ftz;  // as the renderer traces (render.cpp); the caller's mode after
+    Scene scene;
+    const uint32_t mat = add_material(scene);
+    // Object space (make_quadric's): base at z = 0, top at z = h = 2 (the cone: radius 1 to 0.4), or
+    // a unit disc at z = 0.
+    const bool disc = cfg.kind == QuadricKind::Disc;
+    const double r0 = 1.0, r1 = cfg.kind == QuadricKind::Cone ? 0.4 : 1.0;
+    Quadric q = make_quadric(cfg.kind, {0, 0, disc ? 0.0 : -1.0}, {0, 0, 1}, r0, r1, !disc,
+                             placement(cfg.scale, cfg.translation));
+    q.material = mat;
+    scene.quadrics.push_back(q);
+    scene.cameras.push_back(Camera{});
+    OpaqueFilter filter;
+    const SceneView view(scene, MappingOptions{});
+    const auto accel = create_accelerator(cfg.accel, scene, filter);
+    const RayOffsetPolicy policy = accel->ray_offset();
+    const QuadricShape shape(q);
+    const Mat4d& m = q.world_from_object;
+    // Exact outward normal of the object-space point x (on the surface) in world space.
+    auto exact_normal = [&](const Vec3d& x, int part) {
+        const double k = (q.radius1 - q.radius0) / q.height;
+        const double r = q.radius0 + k * x.z;
+        const Vec3d n = disc ? Vec3d{0, 0, 1} : part == 1 ? Vec3d{0, 0, -1} : part == 2 ? Vec3d{0, 0, 1} : Vec3d{x.x, x.y, -k * r};
+        return normalize(q.object_from_world.transposed().apply_vector(n));
+    };
+    std::mt19937_64 rng(cfg.seed);
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    QuadricProbeResult res;
+    const double h = 2.0;
+    const double side_area = disc ? 0.0 : kPiD * (r0 + r1) * std::sqrt(h * h + (r0 - r1) * (r0 - r1));
+    const double cap_area = disc ? kPiD : kPiD * (r0 * r0 + r1 * r1);
+    for (size_t i = 0; i < cfg.points; ++i) {
+        // A point of A in object space: a quarter on a rim, the rest area-uniform.
+        const double phi = 2.0 * kPiD * u01(rng);
+        const Vec3d radial{std::cos(phi), std::sin(phi), 0.0};
+        Vec3d x;
+        int part = 0;
+        if (disc) {
+            x = radial * (i % 4 == 0 ? r0 : r0 * std::sqrt(u01(rng)));
+        } else if (i % 4 == 0) {
+            const bool top = i % 8 == 0;
+            x = radial * (top ? r1 : r0) + Vec3d{0, 0, top ? h : 0.0};
+            part = u01(rng) < 0.5 ? 0 : (top ? 2 : 1);  // which face's normal the ray arrives against
+        } else if (u01(rng) * (side_area + cap_area) < side_area) {
+            const double z = h * u01(rng);
+            x = radial * (r0 + (r1 - r0) * z / h) + Vec3d{0, 0, z};
+        } else {
+            const bool top = u01(rng) * (r0 * r0 + r1 * r1) < r1 * r1;
+            x = radial * ((top ? r1 : r0) * std::sqrt(u01(rng))) + Vec3d{0, 0, top ? h : 0.0};
+            part = top ? 2 : 1;
+        }
+        const Vec3d target = m.apply_point(x);
+        const Vec3d n_target = exact_normal(x, part);
+        // A camera ray from outside, at any cosine down to grazing (discs: either side).
+        const Vec3d face = disc && (i & 1) ? -n_target : n_target;
+        const Vec3d from = hemisphere_direction(face, int(i), rng);
+        Ray cam;
+        cam.org = Vec3f(target + from * (2.0 * cfg.scale));
+        cam.dir = Vec3f(-from);
+        double te[2];
+        uint8_t fe[2];
+        const int ne = quadric_crossings(shape, Vec3d(cam.org), Vec3d(cam.dir), te, fe);
+        const Hit hit = accel->intersect(cam, RayKind::Camera);
+        if (ne == 0 || !(te[0] > 0.0)) {  // the float ray passes the rim outside: nothing to judge
+            continue;
+        }
+        if (!hit.valid()) {
+            ++res.camera_misses;
+            continue;
+        }
+        ++res.points;
+        const SurfacePoint sp = view.surface(cam, hit);
+        const Vec3d exact = Vec3d(cam.org) + Vec3d(cam.dir) * te[0];
+        // Along the surface the error is the float t's (the point is moved onto the surface, not
+        // along it): in ulps of the larger of the point and the distance the ray travelled.
+        const double mag = std::max(max_abs(exact), te[0] * length(Vec3d(cam.dir)));
+        res.point_error_ulps.push_back(max_abs(Vec3d(sp.p) - exact) / double(ulp(float(mag))));
+        res.surface_error_ulps.push_back(max_abs(quadric_point(q, Vec3d(sp.p), fe[0]).p - Vec3d(sp.p)) /
+                                         double(ulp(float(max_abs(Vec3d(sp.p))))));
+        const QuadricPoint qp = quadric_point(q, exact, fe[0]);
+        // Distance of the exact point from the nearest rim (world), for the inward rays below.
+        double rim_distance = std::numeric_limits<double>::infinity();
+        if (!disc) {
+            const Vec3d xo = q.object_from_world.apply_point(exact);
+            const double rho = std::hypot(xo.x, xo.y);
+            const Vec3d dir_xy = rho > 0.0 ? Vec3d{xo.x / rho, xo.y / rho, 0.0} : Vec3d{1.0, 0.0, 0.0};
+            for (const Vec3d rim : {dir_xy * r0, dir_xy * r1 + Vec3d{0, 0, h}})
+                rim_distance = std::min(rim_distance, length(m.apply_point(rim) - exact));
+        }
+        res.normal_error_rad.push_back(angle_between(Vec3d(sp.ng), qp.n));
+        const ShadingFrame frame = shading_frame(sp, cam.dir);
+        for (int kind = 0; kind < 3; ++kind) {
+            const bool inward = kind == 1;
+            if (inward && disc) continue;  // a disc has no inside
+            const Vec3f org = policy.origin(kind == 2 && frame.front ? sp.p_shadow : sp.p, sp.offset_scale,
+                                            inward ? -frame.Ng : frame.Ng);
+            for (int j = 0; j < cfg.directions; ++j) {
+                const Vec3d nd = Vec3d(inward ? -frame.Ng : frame.Ng);
+                Ray r;
+                r.org = org;
+                r.dir = Vec3f(hemisphere_direction(normalize(nd), j, rng));
+                if (inward ? !(dot(r.dir, frame.Ng) < 0.f) : !(dot(r.dir, frame.Ng) > 0.f)) continue;
+                ++res.rays[kind];
+                if (kind == 2) {
+                    r.tfar = float(8.0 * cfg.scale);
+                    if (accel->transmittance(r).x == 0.f) ++res.self_hits[kind];
+                    continue;
+                }
+                const Hit h = accel->intersect(r, inward ? RayKind::Refraction : RayKind::Reflection);
+                if (!inward) {
+                    if (h.valid()) ++res.self_hits[kind];  // A is convex: an outward ray never meets it again
+                    continue;
+                }
+                // Inward: the far side, from the exact point along the same direction. Not judged
+                // where the origin's offset cannot resolve the solid: within 16 offsets of a rim (the
+                // origin may round out through the other face) or a chord shorter than that.
+                double tf[2];
+                uint8_t ff[2];
+                const int nf = quadric_crossings(shape, exact, Vec3d(r.dir), tf, ff);
+                const double far = nf == 2 ? tf[1] : 0.0;
+                const double reach = 16.0 * length(Vec3d(org) - Vec3d(sp.p));
+                if (rim_distance < reach || far * length(Vec3d(r.dir)) < reach) {
+                    ++res.inward_unjudged;
+                    continue;
+                }
+                if (!h.valid()) {
+                    if (far > 0.0) ++res.leaks;  // left the solid without meeting it
+                } else if (double(h.t) < 0.5 * far) {
+                    ++res.self_hits[kind];
+                }
+            }
+        }
+    }
+    // From inside, exactly at the rims (object space, then the world).
+    if (!disc) {
+        const Vec3d inside = m.apply_point({0, 0, 1});  // the middle of the axis
+        for (size_t i = 0; i < cfg.points; ++i) {
+            const double phi = 2.0 * kPiD * u01(rng);
+            const bool top = i & 1;
+            const Vec3d rim = m.apply_point(Vec3d{std::cos(phi), std::sin(phi), 0.0} * (top ? r1 : r0) + Vec3d{0, 0, top ? 2.0 : 0.0});
+            Ray r;
+            r.org = Vec3f(inside);
+            r.dir = Vec3f(rim - Vec3d(r.org));
+            ++res.rim_rays;
+            if (!accel->intersect(r, RayKind::Reflection).valid()) ++res.leaks;
+        }
     }
     return res;
 }

@@ -164,6 +164,46 @@ HitErrorResult probe_hit_error(const std::string& accel, bool sphere, double sca
                                uint64_t seed);
 
 // ---------------------------------------------------------------------------------------------
+// 8. Analytic quadrics: hit points, self-intersection and rims
+
+struct QuadricProbeConfig {
+    std::string accel = "bvh";
+    QuadricKind kind = QuadricKind::Cylinder;  ///< capped cylinder, capped truncated cone, or disc
+    double scale = 1.0, translation = 0.0;    ///< placement(scale, translation): size and distance from the origin
+    size_t points = 2000;                     ///< surface points (a quarter exactly on a rim)
+    int directions = 8;                       ///< secondary rays per point and kind (half grazing)
+    uint64_t seed = 1;
+};
+
+struct QuadricProbeResult {
+    uint64_t points = 0;
+    uint64_t camera_misses = 0;       ///< camera rays at a point of A that the backend missed
+                                      ///< (the double kernel's own crossings say they hit)
+    uint64_t rays[3] = {0, 0, 0};     ///< 0 outward (reflection), 1 inward (refraction), 2 shadow
+    uint64_t self_hits[3] = {0, 0, 0};///< outward/shadow rays that met A again; inward rays that met
+                                      ///< A before half of the exact chord
+    uint64_t leaks = 0;               ///< inward rays that left the closed solid without meeting it,
+                                      ///< and rays from inside aimed at the rims that met nothing
+    uint64_t rim_rays = 0;
+    uint64_t inward_unjudged = 0;     ///< inward rays from within 16 offsets of a rim, or whose exact
+                                      ///< chord is shorter than that: the offset origin cannot resolve
+                                      ///< the solid there (it may round out through the other face)
+    std::vector<double> point_error_ulps;  ///< |SceneView p - exact hit| in ulp(max(max|exact|, t |d|)):
+                                           ///< along the surface, the float t's rounding
+    std::vector<double> surface_error_ulps;///< SceneView p's distance off the surface, ulp(max|p|)
+    std::vector<double> normal_error_rad;  ///< SceneView's normal against the exact one
+};
+
+/// A capped cylinder, capped truncated cone or a disc A (Scene::quadrics) placed by
+/// placement(scale, translation); camera rays at random points of its side, caps and rims from
+/// all angles down to grazing; SceneView's point and normal against the exact crossing (the
+/// double kernel from the exact ray); secondary rays spawned as the integrator does (offset by the
+/// backend's policy): outward and shadow rays must not meet A, inward rays must cross the solid to
+/// its far side (judged beyond 16 offsets from a rim); rays from inside aimed exactly at the rims
+/// must meet it.
+QuadricProbeResult probe_quadric(const QuadricProbeConfig& config);
+
+// ---------------------------------------------------------------------------------------------
 // 2. Scale and translation invariance of images
 
 /// Uniformly scales the whole scene by s about the world origin and then translates it by

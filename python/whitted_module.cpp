@@ -257,6 +257,7 @@ py::dict info_dict(const PyScene& s) {
     d["instances"] = sc.instances.size();
     d["triangles"] = sc.instanced_triangle_count();
     d["spheres"] = sc.spheres.size();
+    d["quadrics"] = sc.quadrics.size();
     d["planes"] = sc.planes.size();
     d["materials"] = sc.materials.size();
     d["lights"] = sc.lights.size();

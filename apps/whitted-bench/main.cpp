@@ -28,7 +28,8 @@ int main(int argc, char** argv) {
     std::vector<app::Command> commands{app::register_bench_aa(*bench),        app::register_bench_accel(*bench),
                                        app::register_bench_anim(*bench),      app::register_bench_env(*bench),
                                        app::register_bench_materials(*bench), app::register_bench_process(*bench),
-                                       app::register_bench_scale(*bench),     app::register_bench_skip(*bench),
+                                       app::register_bench_quadrics(*bench),  app::register_bench_scale(*bench),
+                                       app::register_bench_skip(*bench),
                                        app::register_bench_stability(*bench)};
     for (app::Command& c : commands) c.app->fallthrough();
     try {

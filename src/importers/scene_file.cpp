@@ -650,13 +650,15 @@ private:
                 continue;
             const std::string ptr = sub("/objects", i);
             const Json o = scene_file::parse_object(m_doc, i);
-            if (!o.is_object()) expected(o, ptr, "an object (sphere, plane, box or mesh)");
-            const std::string type =
-                choice(require(o, "type", ptr, "an object", "\"sphere\", \"plane\", \"box\" or \"mesh\""),
-                       sub(ptr, "type"), {"sphere", "plane", "box", "mesh"});
+            if (!o.is_object()) expected(o, ptr, "an object (sphere, cylinder, cone, disc, plane, box or mesh)");
+            const std::string type = choice(
+                require(o, "type", ptr, "an object",
+                        "\"sphere\", \"cylinder\", \"cone\", \"disc\", \"plane\", \"box\" or \"mesh\""),
+                sub(ptr, "type"), {"sphere", "cylinder", "cone", "disc", "plane", "box", "mesh"});
             std::string name = fmt::format("{} {}", type, counts[type]++);
             if (const Json* n = member(o, "name")) name = string(*n, sub(ptr, "name"));
             if (type == "sphere") read_sphere(o, ptr, name);
+            else if (type == "cylinder" || type == "cone" || type == "disc") read_quadric(o, ptr, name, type);
             else if (type == "plane") read_plane(o, ptr, name);
             else if (type == "box") read_box(o, ptr, name);
             else read_mesh(o, ptr, name);
@@ -696,6 +698,65 @@ private:
         s.radius = number(require(o, "radius", ptr, "a sphere", "a number > 0"), sub(ptr, "radius"), kPositive);
         s.material = material_ref(o, ptr);
         m_scene.spheres.push_back(std::move(s));
+    }
+
+    /// Cylinder {base, apex, radius, open}, cone {base, base_radius, apex, apex_radius, open} (NFF's
+    /// cone: a truncated cone, a point at an end of radius 0) and disc {center, normal, radius,
+    /// inner_radius}, each with a material and a transform (Scene::Quadric).
+    void read_quadric(const Json& o, const std::string& ptr, const std::string& name, const std::string& type) {
+        QuadricKind kind = QuadricKind::Disc;
+        Vec3d base, apex;
+        double r0 = 0.0, r1 = 0.0, inner = 0.0;
+        bool caps = false;
+        if (type == "disc") {
+            check_object(o, ptr, "a disc",
+                         {"type", "name", "center", "normal", "radius", "inner_radius", "material", "transform", "comment"});
+            base = vec3(require(o, "center", ptr, "a disc", "an array of 3 numbers"), sub(ptr, "center"));
+            Vec3d normal{0, 1, 0};
+            if (const Json* n = member(o, "normal")) normal = direction(*n, sub(ptr, "normal"));
+            apex = base + normal;
+            r0 = r1 = number(require(o, "radius", ptr, "a disc", "a number > 0"), sub(ptr, "radius"), kPositive);
+            if (const Json* in = member(o, "inner_radius")) {
+                inner = number(*in, sub(ptr, "inner_radius"), kNonNegative);
+                if (!(inner < r0)) fail(sub(ptr, "inner_radius"), "inner_radius ({}) must be less than radius ({})", inner, r0);
+            }
+        } else {
+            const bool cone = type == "cone";
+            if (cone)
+                check_object(o, ptr, "a cone",
+                             {"type", "name", "base", "base_radius", "apex", "apex_radius", "open", "material", "transform", "comment"});
+            else
+                check_object(o, ptr, "a cylinder", {"type", "name", "base", "apex", "radius", "open", "material", "transform", "comment"});
+            const char* what = cone ? "a cone" : "a cylinder";
+            kind = cone ? QuadricKind::Cone : QuadricKind::Cylinder;
+            base = vec3(require(o, "base", ptr, what, "an array of 3 numbers"), sub(ptr, "base"));
+            apex = vec3(require(o, "apex", ptr, what, "an array of 3 numbers"), sub(ptr, "apex"));
+            const double height = length(apex - base);
+            if (!(height > 0.0) || !std::isfinite(height))
+                fail(sub(ptr, "apex"), "apex is the base point: the {} has no length", type);
+            if (cone) {
+                r0 = number(require(o, "base_radius", ptr, what, "a number >= 0"), sub(ptr, "base_radius"), kNonNegative);
+                r1 = number(require(o, "apex_radius", ptr, what, "a number >= 0"), sub(ptr, "apex_radius"), kNonNegative);
+                if (!(r0 > 0.0 || r1 > 0.0))
+                    fail(sub(ptr, "apex_radius"), "base_radius and apex_radius are both 0: the cone has no surface");
+            } else {
+                r0 = r1 = number(require(o, "radius", ptr, what, "a number > 0"), sub(ptr, "radius"), kPositive);
+            }
+            caps = true;
+            if (const Json* op = member(o, "open")) caps = !boolean(*op, sub(ptr, "open"));
+        }
+        const uint32_t material = material_ref(o, ptr);
+        Mat4d xf;
+        if (const Json* t = member(o, "transform")) xf = transform(*t, sub(ptr, "transform"));
+        Quadric q = make_quadric(kind, base, apex, r0, r1, caps, xf);
+        q.inner_radius = inner;
+        q.material = material;
+        q.name = name;
+        const Bounds3d b = quadric_bounds(q);
+        const double limit = double(std::numeric_limits<float>::max());
+        if (!(max_abs(b.lo) <= limit && max_abs(b.hi) <= limit))
+            fail(ptr, "the {} reaches beyond the float range (|coordinate| > {})", type, limit);
+        m_scene.quadrics.push_back(std::move(q));
     }
 
     void read_plane(const Json& o, const std::string& ptr, const std::string& name) {

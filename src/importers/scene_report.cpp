@@ -247,10 +247,10 @@ std::string describe_scene(const Scene& scene, ReportDetail detail) {
     };
     line(fmt::format("file: {}", scene.source));
     line(
-        fmt::format("counts: meshes={} triangles={} instanced_triangles={} instances={} spheres={} materials={} "
-                    "textures={} lights={} cameras={} planes={} warnings={}",
+        fmt::format("counts: meshes={} triangles={} instanced_triangles={} instances={} spheres={} quadrics={} "
+                    "materials={} textures={} lights={} cameras={} planes={} warnings={}",
                     scene.meshes.size(), scene.mesh_triangle_count(), scene.instanced_triangle_count(),
-                    scene.instances.size(), scene.spheres.size(), scene.materials.size(), scene.textures.size(),
+                    scene.instances.size(), scene.spheres.size(), scene.quadrics.size(), scene.materials.size(), scene.textures.size(),
                     scene.lights.size(), scene.cameras.size(), scene.planes.size(), scene.warnings.size()));
     const Bounds3d b = scene.world_bounds();
     if (b.empty())
@@ -265,6 +265,18 @@ std::string describe_scene(const Scene& scene, ReportDetail detail) {
         const Sphere& sp = scene.spheres[i];
         line(fmt::format("sphere[{}]: name=\"{}\" center={} radius={} material={}", i, sp.name, vec3(sp.center),
                          num(sp.radius), sp.material));
+    }
+    for (size_t i = 0; i < scene.quadrics.size(); ++i) {
+        const Quadric& q = scene.quadrics[i];
+        static constexpr const char* kKinds[] = {"cylinder", "cone", "disc"};
+        const Bounds3d qb = quadric_bounds(q);
+        const std::string shape =
+            q.kind == QuadricKind::Disc
+                ? fmt::format("radius={} inner_radius={}", num(q.radius0), num(q.inner_radius))
+                : fmt::format("radius0={} radius1={} height={} caps={}", num(q.radius0), num(q.radius1), num(q.height),
+                              q.caps ? "yes" : "no");
+        line(fmt::format("{}[{}]: name=\"{}\" {} bounds=({}, {}) material={}", kKinds[int(q.kind)], i, q.name, shape,
+                         vec3(qb.lo), vec3(qb.hi), q.material));
     }
     for (size_t i = 0; i < scene.planes.size(); ++i) {
         const Plane& pl = scene.planes[i];

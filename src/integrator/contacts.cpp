@@ -42,7 +42,7 @@ std::pair<double, double> plane_extent(const Plane& p, const Bounds3d& b) {
 }
 
 /// Whether two objects can share a face: exact for spheres and planes, overlapping bounds
-/// (conservative) for meshes.
+/// (conservative) for meshes and quadrics.
 bool may_touch(const ContactObject& a, const ContactObject& b) {
     if (a.kind == GeomKind::Plane && b.kind == GeomKind::Plane) {
         const double tol = touch_tolerance(std::max(max_abs(a.plane->point), max_abs(b.plane->point)));
@@ -92,6 +92,11 @@ std::vector<ContactObject> contact_objects(const Scene& scene, Select select) {
         o.sphere = &s;
         objects.push_back(o);
     }
+    for (size_t i = 0; i < scene.quadrics.size(); ++i) {
+        const Quadric& q = scene.quadrics[i];
+        if (!select(q.material)) continue;
+        objects.push_back({object_index(scene, scene.quadric_geom_id(i), kInvalidId), GeomKind::Quadric, quadric_bounds(q)});
+    }
     for (size_t i = 0; i < scene.planes.size(); ++i) {
         const Plane& p = scene.planes[i];
         if (!select(p.material)) continue;
@@ -127,7 +132,8 @@ void extract_objects(const Scene& scene, const std::vector<uint8_t>& keep, Scene
         sub.instances.push_back(si);
         inst.push_back(i);
     }
-    // Analytic objects (spheres, planes: geometry ids after the meshes), with the one material.
+    // Analytic objects (spheres, quadrics, planes: geometry ids after the meshes), with the one
+    // material.
     auto extract = [&](const auto& from, auto& to, uint32_t first_geom) {
         for (size_t i = 0; i < from.size(); ++i) {
             const uint32_t g = first_geom + uint32_t(i);
@@ -138,6 +144,7 @@ void extract_objects(const Scene& scene, const std::vector<uint8_t>& keep, Scene
         }
     };
     extract(scene.spheres, sub.spheres, scene.sphere_geom_id(0));
+    extract(scene.quadrics, sub.quadrics, scene.quadric_geom_id(0));
     extract(scene.planes, sub.planes, scene.plane_geom_id(0));
 }
 
@@ -220,7 +227,7 @@ Hit ContactSearch::probe_at(const Vec3f& p, const Vec3f& n, float reach, Ray& pr
 
 bool DielectricContacts::accept(const Ray& ray, const Hit& hit, RayKind) const {
     // Front faces by the same winding rule as SceneView (ng from the world vertices in double;
-    // spheres: outward; planes: `normal`).
+    // spheres and quadrics: outward; planes: `normal`).
     const Vec3d d(ray.dir);
     switch (m_sub.geom_kind(hit.geom)) {
         case GeomKind::Mesh: {
@@ -229,11 +236,12 @@ bool DielectricContacts::accept(const Ray& ray, const Hit& hit, RayKind) const {
             return dot(cross(p[1] - p[0], p[2] - p[0]), d) < 0.0;
         }
         case GeomKind::Sphere: {
-            const Sphere& s = m_sub.spheres[hit.geom - m_sub.meshes.size()];
+            const Sphere& s = m_sub.sphere_of(hit.geom);
             return dot(Vec3d(ray.org) + d * double(hit.t) - s.center, d) < 0.0;
         }
-        case GeomKind::Plane:
-            return dot(m_sub.planes[hit.geom - m_sub.meshes.size() - m_sub.spheres.size()].normal, d) < 0.0;
+        case GeomKind::Quadric:
+            return dot(quadric_point(m_sub.quadric_of(hit.geom), Vec3d(ray.org) + d * double(hit.t), int(hit.prim)).n, d) < 0.0;
+        case GeomKind::Plane: return dot(m_sub.plane_of(hit.geom).normal, d) < 0.0;
     }
     return false;
 }

@@ -77,8 +77,8 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
     const double accel_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     m_build_seconds = std::chrono::duration<double>(Clock::now() - m_started).count();
     const AccelStats as = m_accel->stats();
-    const size_t primitives = scene.instanced_triangle_count() + scene.spheres.size();
-    log_info("accelerator: {}{}, built in {:.3f}s, {:.1f} MiB ({:.1f} B per triangle or sphere)", m_accel->name(),
+    const size_t primitives = scene.instanced_triangle_count() + scene.spheres.size() + scene.quadrics.size();
+    log_info("accelerator: {}{}, built in {:.3f}s, {:.1f} MiB ({:.1f} B per primitive)", m_accel->name(),
              m_accel->name() == "embree" ? (settings.robust ? " (robust)" : " (not robust: --no-robust)") : "",
              accel_seconds, double(as.bytes) / double(1 << 20),
              primitives ? double(as.bytes) / double(primitives) : 0.0);

@@ -160,6 +160,7 @@ template <bool kAttributes>
 SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& cone) const {
     switch (m_scene.geom_kind(hit.geom)) {
         case GeomKind::Sphere: return sphere_surface<kAttributes>(ray, hit, cone);
+        case GeomKind::Quadric: return quadric_surface<kAttributes>(ray, hit, cone);
         case GeomKind::Plane: return plane_surface<kAttributes>(ray, hit, cone);
         case GeomKind::Mesh: break;
     }
@@ -276,7 +277,7 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
 
 template <bool kAttributes>
 SurfacePoint SceneView::sphere_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const {
-    const Sphere& sphere = m_scene.spheres[hit.geom - m_scene.meshes.size()];
+    const Sphere& sphere = m_scene.sphere_of(hit.geom);
     SurfacePoint sp;
     sp.material = sphere.material;
     // o + t d carries the error of t; re-project it onto the sphere in double (pbrt-v4,
@@ -317,8 +318,35 @@ SurfacePoint SceneView::sphere_surface(const Ray& ray, const Hit& hit, const Ray
 }
 
 template <bool kAttributes>
+SurfacePoint SceneView::quadric_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const {
+    const Quadric& quadric = m_scene.quadric_of(hit.geom);
+    SurfacePoint sp;
+    sp.material = quadric.material;
+    // o + t d moved onto the face the ray crossed (Hit::prim) in double (quadric_point), as for spheres.
+    const QuadricPoint qp = quadric_point(quadric, Vec3d(ray.org) + Vec3d(ray.dir) * double(hit.t), int(hit.prim));
+    sp.p = Vec3f(qp.p);
+    sp.p_shadow = sp.p;
+    // quadric_crossings solves in double about the quadric's centre: its t error is far below a
+    // float ulp of the point; the unit is that of planes (2^-26 of the object's extent).
+    sp.offset_scale = float(max_abs(quadric.world_from_object.apply_point({0.0, 0.0, 0.0}))) * 0x1p-26f;
+    sp.ng = sp.ns = sp.nc = Vec3f(qp.n);
+    if constexpr (!kAttributes) return sp;
+    const bool uvs = m_needs_uv[quadric.material] != 0;
+    if (uvs) sp.uv[0] = sp.uv[1] = Vec2f{float(qp.u), float(qp.v)};
+    const float width = cone.width_at(hit.t);
+    if (width > 0.f) {
+        const float cos_theta = std::max(std::abs(dot(sp.ng, ray.dir)), 1e-3f);
+        sp.footprint = width / cos_theta;
+        if (!uvs) return sp;
+        const float lod = std::log2(sp.footprint) - float(0.5 * std::log2(qp.uv_area));
+        sp.uv_lod[0] = sp.uv_lod[1] = std::isfinite(lod) ? lod : -kInfinity;
+    }
+    return sp;
+}
+
+template <bool kAttributes>
 SurfacePoint SceneView::plane_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const {
-    const Plane& plane = m_scene.planes[hit.geom - m_scene.meshes.size() - m_scene.spheres.size()];
+    const Plane& plane = m_scene.plane_of(hit.geom);
     SurfacePoint sp;
     sp.material = plane.material;
     // o + t d, projected back onto the plane in double.

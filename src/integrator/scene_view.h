@@ -119,6 +119,8 @@ private:
     SurfacePoint sphere_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const;
     template <bool kAttributes>
     SurfacePoint plane_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const;
+    template <bool kAttributes>
+    SurfacePoint quadric_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const;
 
     struct InstanceXf {
         float m[12];            ///< world_from_object, row-major 3x4

@@ -132,6 +132,53 @@ int intersect_sphere(const RRay& r, const Sphere& sp, double t[2]) {
     return n;
 }
 
+/// The crossings of a quadric's surfaces in (tnear, tfar], ascending, with the face each
+/// crosses (QuadricPoint::part; 0 to 4 crossings: a ray through a rim may report the side and
+/// the cap). Plainly: the ray in object space, the side's quadratic in long double with the
+/// textbook roots, each cap and disc as a plane crossing within its radius; independent of the
+/// renderer's interval form (accel/common/quadric.h).
+int intersect_quadric(const RRay& r, const Quadric& q, double t[4], uint32_t face[4]) {
+    const V3 o = q.object_from_world.apply_point(r.org), d = q.object_from_world.apply_vector(r.dir);
+    int n = 0;
+    auto keep = [&](double root, uint32_t f) {
+        if (root > r.tnear && root <= r.tfar) t[n] = root, face[n++] = f;
+    };
+    auto plane_z = [&](double z, double r_in, double r_out, uint32_t f) {
+        if (d.z == 0.0) return;
+        const double root = (z - o.z) / d.z;
+        const double x = o.x + root * d.x, y = o.y + root * d.y, rr = x * x + y * y;
+        if (rr <= r_out * r_out && rr >= r_in * r_in) keep(root, f);
+    };
+    if (q.kind == QuadricKind::Disc) {
+        plane_z(0.0, q.inner_radius, q.radius0, 0);
+        return n;
+    }
+    using L = long double;
+    const L k = (L(q.radius1) - L(q.radius0)) / L(q.height);
+    const L ro = L(q.radius0) + k * L(o.z);
+    const L a = L(d.x) * d.x + L(d.y) * d.y - k * k * d.z * d.z;
+    const L b = 2 * (L(o.x) * d.x + L(o.y) * d.y - k * d.z * ro);
+    const L c = L(o.x) * o.x + L(o.y) * o.y - ro * ro;
+    std::vector<L> roots;
+    if (a != 0) {
+        const L disc = b * b - 4 * a * c;
+        if (disc >= 0) roots = {(-b - std::sqrt(disc)) / (2 * a), (-b + std::sqrt(disc)) / (2 * a)};
+    } else if (b != 0) {
+        roots = {-c / b};
+    }
+    for (const L root : roots) {
+        const double z = double(L(o.z) + root * L(d.z));
+        if (z >= 0.0 && z <= q.height) keep(double(root), 0);
+    }
+    if (q.caps) {
+        plane_z(0.0, 0.0, q.radius0, 1);
+        plane_z(q.height, 0.0, q.radius1, 2);
+    }
+    for (int i = 1; i < n; ++i)  // insertion sort by t, faces alongside
+        for (int j = i; j > 0 && t[j] < t[j - 1]; --j) std::swap(t[j], t[j - 1]), std::swap(face[j], face[j - 1]);
+    return n;
+}
+
 bool intersect_plane(const RRay& r, const Plane& pl, double& t) {
     const double denom = dot(pl.normal, r.dir);
     if (denom == 0.0 || std::isnan(denom)) return false;
@@ -214,7 +261,7 @@ private:
         const V3 hit_point = ray.org + ray.dir * hit.t;
         switch (m_scene.geom_kind(hit.geom)) {
             case GeomKind::Sphere: {
-                const Sphere& sp = m_scene.spheres[hit.geom - m_scene.meshes.size()];
+                const Sphere& sp = m_scene.sphere_of(hit.geom);
                 V3 n = hit_point - sp.center;
                 const double len = length(n);
                 n = len > 0.0 ? n / len : -ray.dir;
@@ -226,8 +273,18 @@ private:
                 s.material = sp.material;
                 return s;
             }
+            case GeomKind::Quadric: {
+                const Quadric& q = m_scene.quadric_of(hit.geom);
+                const QuadricPoint qp = quadric_point(q, hit_point, int(hit.prim));
+                s.p = s.p_shadow = qp.p;
+                s.scale = 0.5 * length(quadric_bounds(q).diagonal());  // the object's size, as a sphere's radius
+                s.ng = s.ns = qp.n;
+                s.uv[0] = s.uv[1] = Vec2f{float(qp.u), float(qp.v)};
+                s.material = q.material;
+                return s;
+            }
             case GeomKind::Plane: {
-                const Plane& pl = m_scene.planes[hit.geom - m_scene.meshes.size() - m_scene.spheres.size()];
+                const Plane& pl = m_scene.plane_of(hit.geom);
                 s.p = s.p_shadow = hit_point - pl.normal * dot(pl.normal, hit_point - pl.point);
                 s.scale = max_abs(pl.point);
                 s.ng = s.ns = pl.normal;
@@ -435,7 +492,7 @@ private:
     }
 
     /// Calls f(hit) for every primitive the ray crosses in (tnear, tfar], instances first (their
-    /// bounds tested before their triangles), then spheres, then planes.
+    /// bounds tested before their triangles), then spheres, quadrics and planes.
     template <typename F>
     void for_each_crossing(const RRay& ray, F&& f) const {
         const ShearedRay sheared(ray);
@@ -456,6 +513,16 @@ private:
             for (int k = 0; k < n; ++k) {  // both crossings (shadow rays pass through)
                 RHit h;
                 h.t = t[k], h.geom = m_scene.sphere_geom_id(i), h.prim = 0;
+                f(h);
+            }
+        }
+        for (size_t i = 0; i < m_scene.quadrics.size(); ++i) {
+            double t[4];
+            uint32_t face[4];
+            const int n = intersect_quadric(ray, m_scene.quadrics[i], t, face);
+            for (int k = 0; k < n; ++k) {
+                RHit h;
+                h.t = t[k], h.geom = m_scene.quadric_geom_id(i), h.prim = face[k];
                 f(h);
             }
         }

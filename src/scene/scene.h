@@ -68,6 +68,61 @@ struct Sphere {
     std::string name;
 };
 
+/// Which analytic quadric a Quadric is.
+enum class QuadricKind : uint8_t { Cylinder, Cone, Disc };
+
+/// Analytic quadric (scene files): a cylinder, a cone (truncated: a radius at each end, as NFF
+/// writes them) or a disc, defined in its own object space about the +Z axis and placed by
+/// world_from_object (any invertible affine map: a non-uniform scale makes an elliptic cylinder).
+/// Object space:
+///   - cylinder and cone: the side x^2 + y^2 = R(z)^2, R(z) = radius0 + (radius1 - radius0) z / height,
+///     0 <= z <= height; with `caps`, closed by discs at z = 0 (radius0) and z = height (radius1)
+///     into a solid (then a ray crosses it at most twice, in and out, with no gap at the rims);
+///   - disc: z = 0, inner_radius <= sqrt(x^2 + y^2) <= radius0 (an annulus when inner_radius > 0),
+///     front side +Z.
+/// Normals face outward (caps: -Z at the base, +Z at the top). Shading UVs: on the side
+/// u = atan2(y, x) / 2pi + 0.5 (about +Z), v = z / height; on caps and discs u = 0.5 + x / 2r,
+/// v = 0.5 + y / 2r with r the cap's radius. Intersected in double in object space by every
+/// backend (accel/common/quadric.h).
+struct Quadric {
+    QuadricKind kind = QuadricKind::Cylinder;
+    double radius0 = 1.0;             ///< radius at z = 0 (> 0 for discs; >= 0 for cones)
+    double radius1 = 1.0;             ///< radius at z = height (= radius0 for cylinders; unused by discs)
+    double height = 1.0;              ///< length along +Z (> 0; unused by discs)
+    double inner_radius = 0.0;        ///< discs: the hole's radius (0 <= inner < radius0)
+    bool caps = false;                ///< cylinders and cones: closed at both ends
+    Mat4d world_from_object;
+    Mat4d object_from_world;          ///< its inverse (the importer computes it)
+    uint32_t material = 0;            ///< index into Scene::materials
+    std::string name;
+};
+
+/// A quadric placed by its ends: +Z from `base` towards `apex` (height |apex - base| > 0), X and Y
+/// any perpendicular pair, then `transform`. Cylinders take radius0 for both ends. For a disc,
+/// `base` is the centre and `apex - base` the normal (its length does not matter).
+Quadric make_quadric(QuadricKind kind, const Vec3d& base, const Vec3d& apex, double radius0, double radius1,
+                     bool caps, const Mat4d& transform = Mat4d::identity());
+
+/// Exact world-space box of a quadric: the box of its end circles (a cone is their convex hull),
+/// each circle's half-extent along axis k being r sqrt(M(k,0)^2 + M(k,1)^2) for M =
+/// world_from_object. Computed in double.
+Bounds3d quadric_bounds(const Quadric& q);
+
+/// A point of a quadric's surface (QuadricPoint::part: 0 the side or a disc, 1 the base cap,
+/// 2 the top cap).
+struct QuadricPoint {
+    Vec3d p;                          ///< world space, on the surface
+    Vec3d n;                          ///< unit outward world normal (discs: the +Z side)
+    double u = 0, v = 0;              ///< shading UVs (Quadric)
+    double uv_area = 1;               ///< world area of one UV unit square about the point (> 0)
+    int part = 0;
+};
+
+/// The surface point of `q` nearest a world point near it (a hit point o + t d carries the error
+/// of t): the object-space point is moved onto `face` (QuadricPoint::part: the face the ray
+/// crossed, Hit::prim) or, for face < 0, onto the side or cap it lies closest to, in double.
+QuadricPoint quadric_point(const Quadric& q, const Vec3d& world, int face = -1);
+
 /// Infinite plane (scene files): the points p with dot(normal, p - point) = 0. It has no finite
 /// bounds, so it is kept out of every acceleration structure and tested on its own beside them.
 /// Its front side faces `normal`. Shading UVs are world units along `u_axis` and
@@ -81,8 +136,8 @@ struct Plane {
 };
 
 /// Which kind of geometry a geometry id names. Ids are dense: meshes [0, M), spheres
-/// [M, M + S), planes [M + S, M + S + P) (Hit::geom, SurfaceFilter::mesh_flags).
-enum class GeomKind : uint8_t { Mesh, Sphere, Plane };
+/// [M, M + S), quadrics [M + S, M + S + Q), planes after them (Hit::geom, SurfaceFilter::mesh_flags).
+enum class GeomKind : uint8_t { Mesh, Sphere, Quadric, Plane };
 
 // ---------------------------------------------------------------------------------------------
 // Textures
@@ -398,6 +453,7 @@ struct Scene {
     std::vector<Mesh> meshes;
     std::vector<Instance> instances;
     std::vector<Sphere> spheres;
+    std::vector<Quadric> quadrics;    ///< cylinders, cones and discs
     std::vector<Plane> planes;        ///< infinite planes (outside the acceleration structures)
     std::vector<Material> materials;  ///< never empty after import (a default material is added)
     std::vector<Texture> textures;
@@ -415,19 +471,31 @@ struct Scene {
     std::vector<std::string> variants;  ///< the glTF file's KHR_materials_variants variants, in order
     std::string variant;                ///< the one applied (empty: the default materials)
 
-    /// Geometry ids (see GeomKind): meshes, then spheres, then planes.
+    /// Geometry ids (see GeomKind): meshes, then spheres, then quadrics, then planes.
     uint32_t sphere_geom_id(size_t sphere) const { return uint32_t(meshes.size() + sphere); }
-    uint32_t plane_geom_id(size_t plane) const { return uint32_t(meshes.size() + spheres.size() + plane); }
-    uint32_t geometry_count() const { return uint32_t(meshes.size() + spheres.size() + planes.size()); }
-    GeomKind geom_kind(uint32_t geom) const {
-        return geom < meshes.size() ? GeomKind::Mesh
-                                    : geom < meshes.size() + spheres.size() ? GeomKind::Sphere : GeomKind::Plane;
+    uint32_t quadric_geom_id(size_t quadric) const { return uint32_t(meshes.size() + spheres.size() + quadric); }
+    uint32_t plane_geom_id(size_t plane) const {
+        return uint32_t(meshes.size() + spheres.size() + quadrics.size() + plane);
     }
+    uint32_t geometry_count() const { return plane_geom_id(planes.size()); }
+    GeomKind geom_kind(uint32_t geom) const {
+        if (geom < meshes.size()) return GeomKind::Mesh;
+        if (geom < quadric_geom_id(0)) return GeomKind::Sphere;
+        return geom < plane_geom_id(0) ? GeomKind::Quadric : GeomKind::Plane;
+    }
+    /// The sphere, quadric or plane a geometry id of that kind names.
+    const Sphere& sphere_of(uint32_t geom) const { return spheres[geom - meshes.size()]; }
+    const Quadric& quadric_of(uint32_t geom) const { return quadrics[geom - quadric_geom_id(0)]; }
+    const Plane& plane_of(uint32_t geom) const { return planes[geom - plane_geom_id(0)]; }
     /// Material of any geometry id.
     uint32_t geom_material(uint32_t geom) const {
-        if (geom < meshes.size()) return meshes[geom].material;
-        if (geom < meshes.size() + spheres.size()) return spheres[geom - meshes.size()].material;
-        return planes[geom - meshes.size() - spheres.size()].material;
+        switch (geom_kind(geom)) {
+            case GeomKind::Mesh: return meshes[geom].material;
+            case GeomKind::Sphere: return sphere_of(geom).material;
+            case GeomKind::Quadric: return quadric_of(geom).material;
+            case GeomKind::Plane: break;
+        }
+        return plane_of(geom).material;
     }
 
     /// Adds a warning unless the same text was already recorded.
@@ -440,7 +508,7 @@ struct Scene {
         for (int k = 0; k < 3; ++k)
             out[k] = in.world_from_object.apply_point(Vec3d(m.positions[m.indices[size_t(prim) * 3 + size_t(k)]]));
     }
-    /// World-space bounds of all instances and spheres (computed, not cached; planes are infinite
+    /// World-space bounds of all instances, spheres and quadrics (computed, not cached; planes are infinite
     /// and not included).
     Bounds3d world_bounds() const;
     /// Total triangles over instances (a mesh used twice counts twice).

@@ -191,8 +191,9 @@ SceneAnalysis analyze_scene(const Scene& scene, const MappingOptions& mapping) {
         a.features.tangents |= !mesh.tangents.empty();
     }
     for (const Sphere& s : scene.spheres) use(s.material);
+    for (const Quadric& q : scene.quadrics) use(q.material);
     for (const Plane& p : scene.planes) use(p.material);
-    a.features.uv |= !scene.spheres.empty() || !scene.planes.empty();
+    a.features.uv |= !scene.spheres.empty() || !scene.quadrics.empty() || !scene.planes.empty();
     for (const Texture& t : scene.textures)
         for (const MipLevel& level : t.levels) a.texture_bytes += bytes_of(level.texels);
     a.triangles = scene.instanced_triangle_count();
@@ -210,11 +211,11 @@ SceneAnalysis analyze_scene(const Scene& scene, const MappingOptions& mapping) {
     for (size_t i = 0; i < a.materials.size(); ++i)
         if (a.materials[i].used) a.prefilter_levels |= glossy_levels(scene.materials[i], a.materials[i]);
 
-    // Light reach per object: instances (transformed mesh bounds), spheres, planes.
+    // Light reach per object: instances (transformed mesh bounds), spheres, quadrics, planes.
     std::vector<Bounds3d> mesh_bounds(scene.meshes.size());
     for (size_t i = 0; i < scene.meshes.size(); ++i) mesh_bounds[i] = scene.meshes[i].bounds();
     std::vector<Bounds3d> object_bounds;
-    object_bounds.reserve(scene.instances.size() + scene.spheres.size());
+    object_bounds.reserve(scene.instances.size() + scene.spheres.size() + scene.quadrics.size());
     for (const Instance& inst : scene.instances)
         object_bounds.push_back(transform_bounds(
             inst.world_from_object, inst.mesh < mesh_bounds.size() ? mesh_bounds[inst.mesh] : Bounds3d{}));
@@ -224,6 +225,7 @@ SceneAnalysis analyze_scene(const Scene& scene, const MappingOptions& mapping) {
         b.extend(sp.center + Vec3d(sp.radius));
         object_bounds.push_back(b);
     }
+    for (const Quadric& q : scene.quadrics) object_bounds.push_back(quadric_bounds(q));
     a.object_count = uint32_t(object_bounds.size() + scene.planes.size());
     a.lights.assign(scene.lights.size(), LightReach{});
     a.light_offsets.reserve(a.object_count + 1);

@@ -70,7 +70,7 @@ struct MaterialFeatures : FeatureFlags {
 
 /// The OR of MaterialFeatures over the used materials, and what the geometry carries.
 struct SceneFeatures : FeatureFlags {
-    bool uv = false;              ///< some mesh has TEXCOORD_0/1 (or spheres/planes: always parametrised)
+    bool uv = false;              ///< some mesh has TEXCOORD_0/1 (or spheres/quadrics/planes: always parametrised)
     bool tangents = false;        ///< some mesh has tangents
     /// Secondary rays can exist: mirrors, transmission or alpha blend.
     bool recursive() const { return mirror || transmission || alpha_blend; }
@@ -89,7 +89,8 @@ struct SceneAnalysis {
     std::vector<MaterialFeatures> materials;  ///< per Scene::materials
     SceneFeatures features;
     std::vector<LightReach> lights;           ///< per Scene::lights
-    /// Objects: instances [0, I), spheres [I, I + S), planes [I + S, I + S + P) (object_index()).
+    /// Objects: instances [0, I), spheres [I, I + S), quadrics [I + S, I + S + Q), then planes
+    /// (object_index()).
     uint32_t object_count = 0;
     std::vector<uint32_t> light_offsets;      ///< object o's lights: light_indices[offsets[o], offsets[o+1])
     std::vector<uint32_t> light_indices;      ///< ascending light indices per object
@@ -107,11 +108,11 @@ struct SceneAnalysis {
     }
 };
 
-/// Object index of a hit's geometry: the instance for meshes, then spheres, then planes.
+/// Object index of a hit's geometry: the instance for meshes, then spheres, quadrics and planes.
 inline uint32_t object_index(const Scene& scene, uint32_t geom, uint32_t inst) {
     const uint32_t meshes = uint32_t(scene.meshes.size());
     if (geom < meshes) return inst;
-    return uint32_t(scene.instances.size()) + (geom - meshes);  // spheres then planes, in geometry-id order
+    return uint32_t(scene.instances.size()) + (geom - meshes);  // spheres, quadrics, planes: geometry-id order
 }
 
 /// Analyses `scene` as rendered with the glTF mapping `mapping` (the mirror cutoff decides which

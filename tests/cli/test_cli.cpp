@@ -477,7 +477,7 @@ TEST(Cli, BadSceneFileIsOneLineWithLineAndColumn) {
 }
 
 TEST(Cli, BundledSceneFilesRender) {
-    for (const char* name : {"whitted1980.json", "transparent_shadows.json", "glass_mirror_room.json"}) {
+    for (const char* name : {"whitted1980.json", "transparent_shadows.json", "glass_mirror_room.json", "quadrics.json"}) {
         const fs::path out = fs::temp_directory_path() / (std::string("whitted_cli_") + name + ".png");
         fs::remove(out);
         Result r = run("render '" + std::string(WHITTED_ASSETS_DIR) + "/scenes/" + name +

@@ -66,7 +66,7 @@ TEST(SkipCli, RenderPrintsAcceleratorBytesPerPrimitive) {
     const fs::path out = temp_dir("accel_bytes") / "a.png";
     const Result r = run("render '" + kScene + "' --width 16 --height 12 --aa center --no-progress -o '" + out.string() + "'");
     ASSERT_EQ(r.code, 0) << r.err;
-    const size_t at = r.err.find(" B per triangle or sphere)");
+    const size_t at = r.err.find(" B per primitive)");
     ASSERT_NE(at, std::string::npos) << r.err;
     const size_t open = r.err.rfind('(', at);
     EXPECT_GT(std::stod(r.err.substr(open + 1)), 0.0) << r.err;

@@ -424,6 +424,13 @@ TEST(ReferenceCompare, SceneTransparentShadows) {
     const Scene s = load("scenes/transparent_shadows.json");
     expect_agreement(compare("transparent_shadows.json", s, scene_file_settings(s, 64)));
 }
+TEST(ReferenceCompare, SceneQuadrics) {
+    // Cylinders, cones and discs: the reference intersects them its own way (each surface as a
+    // plain quadratic or plane crossing, not the renderer's interval form).
+    const Scene s = load("scenes/quadrics.json");
+    ASSERT_GE(s.quadrics.size(), 8u);
+    expect_agreement(compare("quadrics.json", s, scene_file_settings(s, 64)));
+}
 TEST(ReferenceCompare, SceneDefaultGlb) {
     const Scene s = load("scenes/default.glb");
     expect_agreement(compare("default.glb", s, small(64)));

@@ -122,7 +122,8 @@ INSTANTIATE_TEST_SUITE_P(
                       ImageCase{"default_scene", "scenes/default.glb"},
                       ImageCase{"whitted1980", "scenes/whitted1980.json", 160, 0, 0, false, true},
                       ImageCase{"transparent_shadows", "scenes/transparent_shadows.json", 160, 0, 0, false, true},
-                      ImageCase{"glass_mirror_room", "scenes/glass_mirror_room.json", 160, 0, 0, false, true}),
+                      ImageCase{"glass_mirror_room", "scenes/glass_mirror_room.json", 160, 0, 0, false, true},
+                      ImageCase{"quadrics", "scenes/quadrics.json", 160, 0, 0, false, true}),
     [](const ::testing::TestParamInfo<ImageCase>& info) { return info.param.name; });
 
 }  // namespace

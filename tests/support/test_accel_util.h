@@ -45,18 +45,29 @@ public:
 /// 1 transparent (Kt depends on the sphere); 2 cut away entirely (accept() false, transmittance
 /// 1); 3 the entering side cut away (accept() only where the ray leaves the sphere; transmittance
 /// 1 on entering, Kt 0.6 on leaving). Planes by index % 3: 0 opaque; 1 transparent; 2 a checker
-/// cut-out of 0.7-unit squares in the plane's (u_axis, normal x u_axis) frame.
+/// cut-out of 0.7-unit squares in the plane's (u_axis, normal x u_axis) frame. Quadrics by
+/// index % 3: 0 opaque; 1 transparent (Kt 0.7); 2 cut away where the ray leaves through the outward
+/// normal (accept() false there, transmittance 1; Kt 0.5 where it enters).
 class MixedFilter final : public SurfaceFilter {
 public:
-    explicit MixedFilter(const Scene& s) : m_meshes(uint32_t(s.meshes.size())), m_spheres(s.spheres), m_planes(s.planes) {}
+    explicit MixedFilter(const Scene& s)
+        : m_meshes(uint32_t(s.meshes.size())), m_spheres(s.spheres), m_quadrics(s.quadrics), m_planes(s.planes) {}
 
     bool accept(const Ray& r, const Hit& h, RayKind k) const override {
         if (h.geom < m_meshes) return m_pattern.accept(r, h, k);
         if (const Sphere* sp = sphere(h.geom)) return sphere_index(h.geom) % 4 == 3 ? leaving(r, h, *sp) : false;
+        if (const Quadric* q = quadric(h.geom)) return quadric_index(h.geom) % 3 != 2 || !leaving(r, h, *q);
         return plane_checker(r, h);
     }
     Color transmittance(const Ray& r, const Hit& h) const override {
         if (h.geom < m_meshes) return m_pattern.transmittance(r, h);
+        if (const Quadric* q = quadric(h.geom)) {
+            switch (quadric_index(h.geom) % 3) {
+                case 1: return Color(0.7f);
+                case 2: return leaving(r, h, *q) ? Color(1.f) : Color(0.5f);
+                default: return Color(0.f);
+            }
+        }
         if (const Sphere* sp = sphere(h.geom)) {
             switch (sphere_index(h.geom) % 4) {
                 case 1: return Color(0.9f, 0.7f - 0.02f * float(sphere_index(h.geom) % 9), 0.8f);
@@ -75,14 +86,25 @@ public:
             const uint32_t i = sphere_index(g) % 4;
             return i == 0 ? 0u : i == 1 ? kNeedsTransmittance : kNeedsAccept | kNeedsTransmittance;
         }
+        if (quadric(g)) {
+            const uint32_t i = quadric_index(g) % 3;
+            return i == 0 ? 0u : i == 1 ? kNeedsTransmittance : kNeedsAccept | kNeedsTransmittance;
+        }
         const uint32_t i = plane_index(g) % 3;
         return i == 0 ? 0u : i == 1 ? kNeedsTransmittance : kNeedsAccept | kNeedsTransmittance;
     }
 
 private:
     uint32_t sphere_index(uint32_t g) const { return g - m_meshes; }
-    uint32_t plane_index(uint32_t g) const { return g - m_meshes - uint32_t(m_spheres.size()); }
+    uint32_t quadric_index(uint32_t g) const { return g - m_meshes - uint32_t(m_spheres.size()); }
+    uint32_t plane_index(uint32_t g) const { return quadric_index(g) - uint32_t(m_quadrics.size()); }
     const Sphere* sphere(uint32_t g) const { return g - m_meshes < m_spheres.size() ? &m_spheres[g - m_meshes] : nullptr; }
+    const Quadric* quadric(uint32_t g) const {
+        return g - m_meshes >= m_spheres.size() && quadric_index(g) < m_quadrics.size() ? &m_quadrics[quadric_index(g)] : nullptr;
+    }
+    static bool leaving(const Ray& r, const Hit& h, const Quadric& q) {
+        return dot(quadric_point(q, Vec3d(r.org) + Vec3d(r.dir) * double(h.t), int(h.prim)).n, Vec3d(r.dir)) > 0.0;
+    }
     static bool leaving(const Ray& r, const Hit& h, const Sphere& s) {
         const Vec3d p = Vec3d(r.org) + Vec3d(r.dir) * double(h.t);
         return dot(p - s.center, Vec3d(r.dir)) > 0.0;
@@ -97,6 +119,7 @@ private:
     PatternFilter m_pattern;
     uint32_t m_meshes;
     std::vector<Sphere> m_spheres;
+    std::vector<Quadric> m_quadrics;
     std::vector<Plane> m_planes;
 };
 
@@ -240,6 +263,26 @@ inline std::vector<Ray> make_analytic_rays(const Scene& s, uint32_t per_primitiv
             add(sp.center + n * sp.radius, dot(d, n) > 0 ? d : -d);           // on the surface, outwards
             add(sp.center + side * sp.radius - n * (3 * sp.radius), n);       // tangent
             add(sp.center + n * (4 * sp.radius + 1), -n);                     // at the centre
+        }
+    for (const Quadric& q : s.quadrics)
+        for (uint32_t i = 0; i < per_primitive; ++i) {
+            // Object-space points on the rims, the side and the caps, and the axis, into the world.
+            const Mat4d& m = q.world_from_object;
+            const double phi = 2.0 * kPiD * std::uniform_real_distribution<double>(0, 1)(rng);
+            const Vec3d radial{std::cos(phi), std::sin(phi), 0.0};
+            const Vec3d rim0 = m.apply_point(radial * q.radius0);
+            const Vec3d rim1 = m.apply_point(radial * q.radius1 + Vec3d{0, 0, q.kind == QuadricKind::Disc ? 0.0 : q.height});
+            const Vec3d mid = m.apply_point(radial * (0.5 * (q.radius0 + q.radius1)) + Vec3d{0, 0, 0.5 * q.height});
+            const Vec3d axis0 = m.apply_point({0, 0, 0}), axis1 = m.apply_point({0, 0, q.height});
+            const double size = length(quadric_bounds(q).diagonal());
+            const Vec3d d = unit();
+            add(rim0 - d * (2 * size), d);                                  // through a rim
+            add(rim1 - d * (2 * size), d);
+            add(mid - d * (2 * size), d);                                   // through the side
+            add(axis0 + (axis0 - axis1) * 2.0, axis1 - axis0);              // along the axis
+            const Vec3d tangent = normalize(cross(m.apply_vector(radial), m.apply_vector({0, 0, 1})));
+            add(m.apply_point(radial * (q.radius0 * 1.0000001)) - tangent * size, tangent);  // grazing the base rim
+            add(axis0 * 0.5 + axis1 * 0.5, d);                              // from inside
         }
     for (const Plane& pl : s.planes)
         for (uint32_t i = 0; i < per_primitive; ++i) {

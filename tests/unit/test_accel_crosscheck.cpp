@@ -282,18 +282,15 @@ TEST(AccelCrossCheck, AnalyticSceneOpaque) {
     run_all(s, OpaqueFilter{}, 300, "analytic/opaque", false, make_analytic_rays(s, 4, 17));
 }
 
-TEST(AccelCrossCheck, AnalyticSceneWithFilters) {
-    const Scene s = analytic_scene();
-    const MixedFilter filter(s);
-    const std::vector<Ray> extra = make_analytic_rays(s, 4, 18);
-    run_all(s, filter, 300, "analytic/filter", false, extra);
-    // Embree (user-geometry spheres, planes beside it) against the same oracle on the random and
-    // the analytic rays: its triangle test is not watertight, so rays aimed exactly at vertices
-    // and edges (make_rays' edge cases) are left to test_accel_embree; here sphere and plane hits
-    // must agree exactly, and triangle hits up to rare ties. Embree's triangle t is less exact
-    // than the watertight one (~1e-6 of the coordinates' magnitude, which is a large relative
-    // error for the short hits of rays starting next to a mesh): a distance tolerance of 2e-6 of
-    // the scene size applies to triangle hits.
+/// Embree (user-geometry spheres and quadrics, planes beside it) against the brute-force oracle
+/// on random rays and `extra`: its triangle test is not watertight, so rays aimed exactly at
+/// vertices and edges (make_rays' edge cases) are left to test_accel_embree; here analytic hits
+/// must agree exactly, and triangle hits up to rare ties. Embree's triangle t is less exact than
+/// the watertight one (~1e-6 of the coordinates' magnitude, which is a large relative error for
+/// the short hits of rays starting next to a mesh): a distance tolerance of 2e-6 of the scene
+/// size applies to triangle hits.
+void expect_embree_matches_brute(const Scene& s, const SurfaceFilter& filter, const std::vector<Ray>& extra,
+                                 const char* label) {
     const double tol = 2e-6 * length(s.world_bounds().diagonal());
     std::vector<Ray> rays = make_rays(s, 300, 1234);
     rays.resize(300);
@@ -315,11 +312,72 @@ TEST(AccelCrossCheck, AnalyticSceneWithFilters) {
         const Color te = embree->transmittance(r), tb = brute->transmittance(r);
         for (int k = 0; k < 3; ++k) bad_tr += std::fabs(te[k] - tb[k]) > 1e-5f * std::max(1e-3f, std::fabs(tb[k]));
     }
-    std::printf("[ analytic/filter ] %-24s %zu rays: %zu differ (%zu with neither answer a triangle), %zu transmittance "
-                "channel mismatches\n", "embree", rays.size(), differ, analytic_differ, bad_tr);
+    std::printf("[ %s ] %-24s %zu rays: %zu differ (%zu with neither answer a triangle), %zu transmittance "
+                "channel mismatches\n", label, "embree", rays.size(), differ, analytic_differ, bad_tr);
     EXPECT_EQ(analytic_differ, 0u);
     EXPECT_LE(double(differ), 0.002 * double(rays.size()));
     EXPECT_LE(double(bad_tr), 0.002 * double(rays.size()));
+}
+
+TEST(AccelCrossCheck, AnalyticSceneWithFilters) {
+    const Scene s = analytic_scene();
+    const MixedFilter filter(s);
+    const std::vector<Ray> extra = make_analytic_rays(s, 4, 18);
+    run_all(s, filter, 300, "analytic/filter", false, extra);
+    expect_embree_matches_brute(s, filter, extra, "analytic/filter");
+}
+
+// ---- analytic quadrics (cylinders, cones, discs) beside meshes, spheres and a plane ----
+
+void add_quadric(Scene& s, QuadricKind kind, Vec3d base, Vec3d apex, double r0, double r1, bool caps,
+                 const Mat4d& xf = Mat4d::identity(), double inner = 0.0) {
+    Quadric q = make_quadric(kind, base, apex, r0, r1, caps, xf);
+    q.inner_radius = inner;
+    q.name = "q" + std::to_string(s.quadrics.size());
+    s.quadrics.push_back(q);
+}
+
+Scene quadric_scene() {
+    using K = QuadricKind;
+    Scene s;
+    add_mesh_instance(s, make_uv_sphere({0, 0, 0}, 1.f, 16, 24));                     // mesh 0
+    add_mesh_instance(s, make_terrain(16, 0.3f), Mat4d::translate({0, 0, -1.5}));      // mesh 1
+    add_sphere(s, {1.2, 0.4, 0.2}, 0.8);
+    add_sphere(s, {-2, 1, 0}, 0.6);
+    add_quadric(s, K::Cylinder, {-2, -1, 0}, {-2, 2, 0}, 0.7, 0.7, true);              // 0 opaque, capped, through sphere 1
+    add_quadric(s, K::Cylinder, {1, -2, -1}, {2, -1, 1}, 0.3, 0.3, false);             // 1 transparent, open, tilted
+    add_quadric(s, K::Cylinder, {2, 1, 0}, {2, 2.5, 0}, 0.5, 0.5, true);               // 2 cut on leaving, capped
+    add_quadric(s, K::Cone, {0, 1.5, -1}, {0, 2.8, -1}, 0.9, 0.2, true);               // 3 opaque truncated cone
+    add_quadric(s, K::Cone, {-1, -2.5, 1}, {-1, -1, 1.5}, 0.6, 0.0, false);            // 4 transparent, open, to a point
+    add_quadric(s, K::Cone, {0.5, 0, 2}, {0.5, 0, 0.5}, 0.0, 0.8, true);               // 5 cut, apex first
+    add_quadric(s, K::Disc, {0, -2.9, 0}, {0, -1.9, 0}, 1.5, 1.5, false);              // 6 opaque disc on the floor
+    add_quadric(s, K::Disc, {-1, 0, 1.5}, {0, 1, 2.5}, 1.0, 1.0, false, Mat4d::identity(), 0.4);  // 7 transparent annulus
+    // 8 cut: an elliptic cylinder (non-uniform scale after a rotation), mirrored
+    add_quadric(s, K::Cylinder, {0, 0, 0}, {0, 0, 1}, 0.5, 0.5, true,
+                Mat4d::translate({-0.5, 0.5, -2}) * Mat4d::scale({-1.5, 0.6, 1}) * Mat4d::rotate(0.3, 0.1, 0.2, 0.927362));
+    add_quadric(s, K::Cylinder, {1.6, 0.4, 0.2}, {0.8, 0.4, 0.2}, 0.2, 0.2, true);     // 9 opaque, through sphere 0
+    add_quadric(s, K::Cone, {-2, 1, 0}, {-2, 1.6, 0}, 0.6, 0.3, true);                 // 10 transparent, on sphere 1
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> pos(-2.5, 2.5), rad(0.05, 0.3);
+    for (int i = 0; i < 18; ++i) {
+        const Vec3d b{pos(rng), pos(rng), pos(rng)}, a = b + Vec3d{pos(rng), pos(rng), pos(rng)} * 0.3;
+        add_quadric(s, K(i % 3), b, a, rad(rng), i % 2 ? rad(rng) : 0.0, i % 4 != 0);
+    }
+    add_plane(s, {0, -3, 0}, {0, 1, 0}, {1, 0, 0});
+    return s;
+}
+
+TEST(AccelCrossCheck, QuadricSceneOpaque) {
+    const Scene s = quadric_scene();
+    run_all(s, OpaqueFilter{}, 400, "quadric/opaque", false, make_analytic_rays(s, 6, 21));
+}
+
+TEST(AccelCrossCheck, QuadricSceneWithFilters) {
+    const Scene s = quadric_scene();
+    const MixedFilter filter(s);
+    const std::vector<Ray> extra = make_analytic_rays(s, 6, 22);
+    run_all(s, filter, 400, "quadric/filter", false, extra);
+    expect_embree_matches_brute(s, filter, extra, "quadric/filter");
 }
 
 /// Filter for closed-form transmittance: every sphere Kt 0.5, every plane Kt 0.8.
@@ -768,7 +826,7 @@ std::unique_ptr<Accelerator> wide_meshes_under(const Scene& s, const SurfaceFilt
     const BvhBuildConfig build = wide_bvh_build_defaults();
     return std::make_unique<TwoLevelAccelerator<float, WideTriangleBvh<8>, NoSpheres, Top>>(
         "bvh", s, filter, [build](const Mesh& m) { return WideTriangleBvh<8>(TrianglePrims<float>(m), build, {}); },
-        [](SpherePrims<float>&&) {
+        [](AnalyticPrims<float>&&) {
             ADD_FAILURE() << "no spheres in these scenes";
             return NoSpheres{};
         },

@@ -32,7 +32,7 @@ TEST(SceneReport, CountsCamerasMaterialsAndWarnings) {
     const auto counts = lines_starting_with(text, "counts: ");
     ASSERT_EQ(counts.size(), 1u);
     EXPECT_TRUE(contains(counts[0],
-                         "meshes=1 triangles=2 instanced_triangles=2 instances=1 spheres=0 materials=1 "
+                         "meshes=1 triangles=2 instanced_triangles=2 instances=1 spheres=0 quadrics=0 materials=1 "
                          "textures=0 lights=1 cameras=2"))
         << counts[0];
     const auto cams = lines_starting_with(text, "camera[");

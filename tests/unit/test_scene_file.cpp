@@ -380,6 +380,72 @@ TEST(SceneFile, InfinitePlanes) {
     }
 }
 
+TEST(SceneFile, CylindersConesAndDiscs) {
+    const Scene s = load_json(doc(R"("materials": {"red": {"kd": [1, 0, 0]}}, "objects": [
+      {"type": "cylinder", "base": [0, 0, 0], "apex": [0, 2, 0], "radius": 0.5, "material": "red"},
+      {"type": "cylinder", "name": "pipe", "base": [1, 0, 0], "apex": [1, 0, 3], "radius": 0.2, "open": true},
+      {"type": "cone", "base": [0, 0, 0], "base_radius": 1, "apex": [0, 0, 1], "apex_radius": 0},
+      {"type": "disc", "center": [0, 1, 0], "normal": [0, 0, 2], "radius": 2, "inner_radius": 0.5},
+      {"type": "cylinder", "base": [0, 0, 0], "apex": [0, 0, 1], "radius": 1, "transform": {"translate": [5, 0, 0], "scale": [2, 1, 1]}}])"));
+    ASSERT_EQ(s.quadrics.size(), 5u);
+    EXPECT_TRUE(s.meshes.empty());  // analytic, not tessellated
+    const Quadric& c = s.quadrics[0];
+    EXPECT_EQ(c.kind, QuadricKind::Cylinder);
+    EXPECT_EQ(c.name, "cylinder 0");
+    EXPECT_TRUE(c.caps);  // closed unless "open"
+    EXPECT_DOUBLE_EQ(c.height, 2.0);
+    EXPECT_DOUBLE_EQ(c.radius1, 0.5);
+    EXPECT_EQ(s.materials[c.material].name, "red");
+    expect_vec(c.world_from_object.apply_point({0, 0, 2}), {0, 2, 0}, 1e-12);  // +Z runs base -> apex
+    EXPECT_EQ(s.quadrics[1].name, "pipe");
+    EXPECT_FALSE(s.quadrics[1].caps);
+    EXPECT_EQ(s.quadrics[2].kind, QuadricKind::Cone);
+    EXPECT_DOUBLE_EQ(s.quadrics[2].radius0, 1.0);
+    EXPECT_DOUBLE_EQ(s.quadrics[2].radius1, 0.0);
+    const Quadric& d = s.quadrics[3];
+    EXPECT_EQ(d.kind, QuadricKind::Disc);
+    EXPECT_DOUBLE_EQ(d.inner_radius, 0.5);
+    expect_vec(d.world_from_object.apply_vector({0, 0, 1}), {0, 0, 1}, 1e-12);  // normal, normalised
+    // The transform applies after the frame: an elliptic cylinder 4 wide in X at x = 5.
+    const Bounds3d b = quadric_bounds(s.quadrics[4]);
+    expect_vec(b.lo, {3, -1, 0}, 1e-12);
+    expect_vec(b.hi, {7, 1, 1}, 1e-12);
+    // Geometry ids: spheres, then quadrics, then planes; world bounds include the quadrics.
+    EXPECT_EQ(s.geom_kind(s.quadric_geom_id(0)), GeomKind::Quadric);
+    EXPECT_EQ(s.geom_material(s.quadric_geom_id(0)), c.material);
+    EXPECT_NEAR(s.world_bounds().hi.x, 7.0, 1e-12);
+    const std::string text = describe_scene(s);
+    EXPECT_CONTAINS(text, "quadrics=5 ");
+    EXPECT_CONTAINS(text, "cylinder[1]: name=\"pipe\" radius0=0.2 radius1=0.2 height=3 caps=no");
+    EXPECT_CONTAINS(text, "disc[3]: name=\"disc 0\" radius=2 inner_radius=0.5");
+}
+
+TEST(SceneFile, ErrorBadQuadrics) {
+    auto error = [](const std::string& objects) { return std::string(error_of(doc("\"objects\": [" + objects + "]")).what()); };
+    EXPECT_CONTAINS(error(R"({"type": "cylinder", "base": [0, 0, 0], "apex": [0, 0, 0], "radius": 1})"),
+                    "/objects/0/apex: apex is the base point: the cylinder has no length");
+    EXPECT_CONTAINS(error(R"({"type": "cylinder", "base": [0, 0, 0], "apex": [0, 1, 0], "radius": 0})"),
+                    "/objects/0/radius: expected a number > 0, got 0");
+    EXPECT_CONTAINS(error(R"({"type": "cylinder", "base": [0, 0, 0], "apex": [0, 1, 0]})"), "/objects/0: missing key 'radius' in a cylinder");
+    EXPECT_CONTAINS(error(R"({"type": "cone", "base": [0, 0, 0], "apex": [0, 1, 0], "base_radius": 0, "apex_radius": 0})"),
+                    "base_radius and apex_radius are both 0");
+    EXPECT_CONTAINS(error(R"({"type": "cone", "base": [0, 0, 0], "apex": [0, 1, 0], "base_radius": -1, "apex_radius": 0})"),
+                    "/objects/0/base_radius: expected a number >= 0, got -1");
+    EXPECT_CONTAINS(error(R"({"type": "disc", "center": [0, 0, 0], "radius": 1, "inner_radius": 1})"),
+                    "/objects/0/inner_radius: inner_radius (1) must be less than radius (1)");
+    EXPECT_CONTAINS(error(R"({"type": "disc", "center": [0, 0, 0], "normal": [0, 0, 0], "radius": 1})"),
+                    "/objects/0/normal: expected a direction");
+    EXPECT_CONTAINS(error(R"({"type": "cylinder", "base": [0, 0, 0], "apex": [0, 1, 0], "radius": 1, "open": "yes"})"),
+                    "/objects/0/open: expected true or false");
+    EXPECT_CONTAINS(error(R"({"type": "cylinder", "base": [0, 0, 0], "apex": [0, 1, 0], "radius": 1, "caps": true})"),
+                    "/objects/0/caps: unknown key 'caps' in a cylinder");
+    EXPECT_CONTAINS(error(R"({"type": "cylinder", "base": [0, 0, 0], "apex": [0, 1, 0], "radius": 1, "transform": {"scale": [1, 0, 1]}})"),
+                    "the transform is singular");
+    EXPECT_CONTAINS(error(R"({"type": "cylinder", "base": [0, 0, 0], "apex": [0, 1, 0], "radius": 3e38, "transform": {"scale": 10}})"),
+                    "beyond the float range");
+    EXPECT_CONTAINS(error(R"({"type": "cylindre"})"), "/objects/0/type: expected one of");
+}
+
 /// Geometric normal of triangle t in world space.
 Vec3d world_face_normal(const Scene& s, const Instance& inst, size_t t) {
     const Mesh& m = s.meshes[inst.mesh];
@@ -797,7 +863,7 @@ TEST(SceneFile, ErrorUnknownKeyWithSuggestion) {
                     "unknown key 'zoom' in a perspective camera (expected one of: type, name, position, look_at");
     // Enumerations suggest too.
     EXPECT_CONTAINS(std::string(error_of(doc(R"("objects": [{"type": "spere"}])")).what()),
-                    "/objects/0/type: expected one of \"sphere\", \"plane\", \"box\", \"mesh\", got \"spere\" (did you mean 'sphere'?)");
+                    "/objects/0/type: expected one of \"sphere\", \"cylinder\", \"cone\", \"disc\", \"plane\", \"box\", \"mesh\", got \"spere\" (did you mean 'sphere'?)");
 }
 
 TEST(SceneFile, ErrorMissingKey) {

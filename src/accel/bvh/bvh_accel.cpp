@@ -172,14 +172,14 @@ template <typename T, typename V>
 std::unique_ptr<Accelerator> make_bvh(const char* name, const Scene& scene, const SurfaceFilter& filter,
                                       const BvhBuildConfig& build, bool flatten = true) {
     using Blas = PrimBvh<T, V, TrianglePrims<T>>;
-    using SphereBlas = PrimBvh<T, V, SpherePrims<T>>;
+    using SphereBlas = PrimBvh<T, V, AnalyticPrims<T>>;
     // Spheres: small leaves (a sphere test costs about as much as a node test).
     BvhBuildConfig sphere_build = build;
     sphere_build.max_leaf_size = std::min(build.max_leaf_size, 2);
     // The mesh builder outlives this call (update() may build a mesh again): settings by value.
     return std::make_unique<TwoLevelAccelerator<T, Blas, SphereBlas>>(
         name, scene, filter, [build](const Mesh& m) { return Blas(TrianglePrims<T>(m), build); },
-        [&](SpherePrims<T>&& s) { return SphereBlas(std::move(s), sphere_build); }, true, flatten);
+        [&](AnalyticPrims<T>&& s) { return SphereBlas(std::move(s), sphere_build); }, true, flatten);
 }
 
 /// `bvh` with N-wide mesh BVHs and an N-wide top level over instances (float boxes); the
@@ -188,24 +188,24 @@ template <int N>
 std::unique_ptr<Accelerator> make_wide_bvh(const Scene& scene, const SurfaceFilter& filter, const BvhBuildConfig& build,
                                            const WideBvhOptions& options, bool flatten) {
     using Blas = WideTriangleBvh<N>;
-    using SphereBlas = PrimBvh<float, AabbVolume<float>, SpherePrims<float>>;
+    using SphereBlas = PrimBvh<float, AabbVolume<float>, AnalyticPrims<float>>;
     using Top = WideInstanceTree<N>;
     BvhBuildConfig sphere_build = build;
     sphere_build.max_leaf_size = std::min(build.max_leaf_size, 2);
     // The mesh and top-level builders outlive this call (update()): settings by value.
     return std::make_unique<TwoLevelAccelerator<float, Blas, SphereBlas, Top>>(
         "bvh", scene, filter, [build, options](const Mesh& m) { return Blas(TrianglePrims<float>(m), build, options); },
-        [&](SpherePrims<float>&& s) { return SphereBlas(std::move(s), sphere_build); },
+        [&](AnalyticPrims<float>&& s) { return SphereBlas(std::move(s), sphere_build); },
         [options](const std::vector<Bounds3f>& boxes) { return Top(boxes, options); }, flatten);
 }
 
 template <typename T>
 std::unique_ptr<Accelerator> make_brute(const Scene& scene, const SurfaceFilter& filter) {
     using Blas = PrimList<T, TrianglePrims<T>>;
-    using SphereBlas = PrimList<T, SpherePrims<T>>;
+    using SphereBlas = PrimList<T, AnalyticPrims<T>>;
     return std::make_unique<TwoLevelAccelerator<T, Blas, SphereBlas>>(
         "brute", scene, filter, [](const Mesh& m) { return Blas(TrianglePrims<T>(m)); },
-        [](SpherePrims<T>&& s) { return SphereBlas(std::move(s)); }, false);
+        [](AnalyticPrims<T>&& s) { return SphereBlas(std::move(s)); }, false);
 }
 
 }  // namespace

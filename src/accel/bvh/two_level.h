@@ -4,7 +4,7 @@
 // origin and direction). The top level (the `Top` parameter) is the binary SAH BVH of
 // bvh_tree.h over the instances' world boxes (BinaryInstanceTree; for the brute-force oracle a
 // plain loop), or `bvh`'s 8/4-wide tree (WideInstanceTree, bvh/wide_bvh.h). The scene's analytic
-// spheres are one more structure of the backend's own kind (SphereBlas, built over SpherePrims in
+// spheres are one more structure of the backend's own kind (SphereBlas, built over AnalyticPrims in
 // world space), traced beside the top level with the world-space ray; infinite planes are added
 // outside (planes.h). With `flatten` (the default for float structures), the meshes that exactly
 // one instance uses (with a transform that keeps orientation) are put in world space into one
@@ -149,7 +149,7 @@ public:
         return std::is_same_v<T, double> ? kDoubleRayOffset : kFloatRayOffset;
     }
     using BlasBuilder = std::function<Blas(const Mesh&)>;
-    using SphereBuilder = std::function<SphereBlas(SpherePrims<T>&&)>;
+    using SphereBuilder = std::function<SphereBlas(AnalyticPrims<T>&&)>;
     using TopBuilder = std::function<Top(const std::vector<Bounds3<T>>&)>;
 
     /// With the binary top level: `bvh_top` false = loop over all instances (the brute-force
@@ -169,7 +169,7 @@ public:
         : m_name(std::move(name)), m_scene(scene), m_filter(filter), m_build_blas(build_blas), m_build_top(build_top) {
         const auto start = std::chrono::steady_clock::now();
         // Spheres: world space, each with its own geometry id and filter flags.
-        SpherePrims<T> spheres(scene, filter);
+        AnalyticPrims<T> spheres(scene, filter);
         if (spheres.size() > 0) m_spheres = std::make_unique<SphereBlas>(build_spheres(std::move(spheres)));
         // Which instances are flattened (none unless at least two would share the flat BLAS).
         m_flat = flattened_instances(scene, flatten && std::is_same_v<T, float>);
@@ -371,16 +371,7 @@ private:
 
     /// World box of an object box under a transform (corners in double, rounded outwards).
     static Bounds3<T> world_box(const Bounds3<T>& object, const Mat4d& world_from_object) {
-        const Bounds3d b = transform_bounds(world_from_object, Bounds3d{Vec3d(object.lo), Vec3d(object.hi)});
-        Bounds3<T> out;
-        for (int k = 0; k < 3; ++k) {
-            T lo = T(b.lo[k]), hi = T(b.hi[k]);
-            if (double(lo) > b.lo[k]) lo = std::nextafter(lo, -std::numeric_limits<T>::infinity());
-            if (double(hi) < b.hi[k]) hi = std::nextafter(hi, std::numeric_limits<T>::infinity());
-            out.lo[k] = lo;
-            out.hi[k] = hi;
-        }
-        return out;
+        return round_outwards<T>(transform_bounds(world_from_object, Bounds3d{Vec3d(object.lo), Vec3d(object.hi)}));
     }
 
     template <class Query>

@@ -31,6 +31,20 @@ inline bool ray_is_traceable(const Ray& r) {
            std::isfinite(r.tnear) && !std::isnan(r.tfar) && r.tnear <= r.tfar;
 }
 
+/// A double-precision box in precision T, rounded outwards (never smaller than `b`).
+template <typename T>
+inline Bounds3<T> round_outwards(const Bounds3d& b) {
+    Bounds3<T> out;
+    for (int k = 0; k < 3; ++k) {
+        T lo = T(b.lo[k]), hi = T(b.hi[k]);
+        if (double(lo) > b.lo[k]) lo = std::nextafter(lo, -std::numeric_limits<T>::infinity());
+        if (double(hi) < b.hi[k]) hi = std::nextafter(hi, std::numeric_limits<T>::infinity());
+        out.lo[k] = lo;
+        out.hi[k] = hi;
+    }
+    return out;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Watertight ray/triangle intersection (Woop, Benthin & Wald 2013, JCGT 2(1))
 

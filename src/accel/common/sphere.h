@@ -63,16 +63,7 @@ struct SphereRay {
 /// World-space box of a sphere in precision T, rounded outwards (computed in double).
 template <typename T>
 inline Bounds3<T> sphere_bounds(const Vec3d& center, double radius) {
-    Bounds3<T> out;
-    for (int k = 0; k < 3; ++k) {
-        const double lo = center[k] - radius, hi = center[k] + radius;
-        T l = T(lo), h = T(hi);
-        if (double(l) > lo) l = std::nextafter(l, -std::numeric_limits<T>::infinity());
-        if (double(h) < hi) h = std::nextafter(h, std::numeric_limits<T>::infinity());
-        out.lo[k] = l;
-        out.hi[k] = h;
-    }
-    return out;
+    return round_outwards<T>(Bounds3d{center - Vec3d(radius), center + Vec3d(radius)});
 }
 
 /// Conservative test whether the sphere's surface passes through the box [lo, hi] (Arvo 1990,

@@ -188,23 +188,24 @@ void occluded_filter(const RTCFilterFunctionNArguments* args) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The scene's spheres as one RTC_GEOMETRY_TYPE_USER geometry in the top-level scene (primitive i
-// = SpherePrims item i). Embree runs no filter functions for user geometry, so the callbacks
+// The scene's spheres and quadrics as one RTC_GEOMETRY_TYPE_USER geometry in the top-level scene
+// (primitive i = AnalyticPrims item i). Embree runs no filter functions for user geometry, so the callbacks
 // apply the same rules as the triangle filters above: accept() for kNeedsAccept, and for shadow
-// rays add_crossing() for both roots with kNeedsTransmittance, else blocked at once. The roots come
-// from the in-house kernel (sphere_roots<float>), so t is the float `bvh` backend's t.
+// rays add_crossing() for both crossings with kNeedsTransmittance, else blocked at once. The
+// crossings come from the in-house kernels (sphere_roots<float>, quadric_crossings), so t is the
+// float `bvh` backend's t.
 
-Hit sphere_hit(const SpherePrims<float>::Item& s, float t) {
+Hit analytic_hit(const AnalyticPrims<float>::Item& s, float t, uint32_t face) {
     Hit h;
     h.t = t;
-    h.prim = 0;
+    h.prim = face;
     h.geom = s.geom;
     h.inst = kInvalidId;
     return h;
 }
 
-void sphere_bounds_fn(const RTCBoundsFunctionArguments* args) {
-    const auto& spheres = *static_cast<const SpherePrims<float>*>(args->geometryUserPtr);
+void analytic_bounds_fn(const RTCBoundsFunctionArguments* args) {
+    const auto& spheres = *static_cast<const AnalyticPrims<float>*>(args->geometryUserPtr);
     const Bounds3f b = spheres.bounds(args->primID);
     args->bounds_o->lower_x = b.lo.x;
     args->bounds_o->lower_y = b.lo.y;
@@ -214,42 +215,47 @@ void sphere_bounds_fn(const RTCBoundsFunctionArguments* args) {
     args->bounds_o->upper_z = b.hi.z;
 }
 
-/// The roots of ray i of a ray packet against sphere `s`.
-bool packet_sphere_roots(RTCRayN* ray, unsigned n, unsigned i, const SpherePrims<float>::Item& s, float& t0,
-                         float& t1) {
+/// The crossings of ray i of a ray packet with item `s` (AnalyticPrims::crossings).
+int packet_crossings(const AnalyticPrims<float>& prims, RTCRayN* ray, unsigned n, unsigned i,
+                     const AnalyticPrims<float>::Item& s, float t[2], uint8_t face[2]) {
     const Vec3f org{RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i), RTCRayN_org_z(ray, n, i)};
     const Vec3f dir{RTCRayN_dir_x(ray, n, i), RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i)};
-    return sphere_roots(org, dir, s.center, s.radius, t0, t1);
+    return prims.crossings(s, org, dir, t, face);
 }
 
-/// Closest hit: the nearer root in (tnear, tfar] that accept() takes, else the farther one.
-void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
-    const auto& spheres = *static_cast<const SpherePrims<float>*>(args->geometryUserPtr);
+/// Closest hit: the nearer crossing in (tnear, tfar] that accept() takes, else the farther one.
+void analytic_intersect_fn(const RTCIntersectFunctionNArguments* args) {
+    const auto& prims = *static_cast<const AnalyticPrims<float>*>(args->geometryUserPtr);
     auto& q = *reinterpret_cast<QueryContext*>(args->context);
-    const SpherePrims<float>::Item& s = spheres.item(args->primID);
+    const AnalyticPrims<float>::Item& s = prims.item(args->primID);
     RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, args->N);
     RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, args->N);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
         float roots[2];
-        if (!packet_sphere_roots(ray, args->N, i, s, roots[0], roots[1])) continue;
+        uint8_t face[2];
+        const int n = packet_crossings(prims, ray, args->N, i, s, roots, face);
         const float tnear = RTCRayN_tnear(ray, args->N, i);
         float& tfar = RTCRayN_tfar(ray, args->N, i);
         const unsigned lane = RTCRayN_id(ray, args->N, i);
-        for (const float t : roots) {
+        for (int r = 0; r < n; ++r) {
+            const float t = roots[r];
             if (!(t > tnear && t <= tfar)) continue;
-            const Hit h = sphere_hit(s, t);
+            const Hit h = analytic_hit(s, t, face[r]);
             if ((s.flags & SurfaceFilter::kNeedsAccept) && !q.filter->accept(q.rays[lane], h, q.kind)) continue;
             if (q.kind == RayKind::Camera) {  // camera_tie_filter's rule (no filter runs for user geometry)
                 if (loses_tie(h, q.best[lane])) continue;
                 record(q.best[lane], h);
             }
             tfar = t;
-            RTCHitN_u(hit, args->N, i) = 0.f;
+            RTCHitN_u(hit, args->N, i) = float(face[r]);  // the face crossed (to_hit: Hit::prim)
             RTCHitN_v(hit, args->N, i) = 0.f;
-            RTCHitN_Ng_x(hit, args->N, i) = RTCRayN_org_x(ray, args->N, i) + t * RTCRayN_dir_x(ray, args->N, i) - float(s.center.x);
-            RTCHitN_Ng_y(hit, args->N, i) = RTCRayN_org_y(ray, args->N, i) + t * RTCRayN_dir_y(ray, args->N, i) - float(s.center.y);
-            RTCHitN_Ng_z(hit, args->N, i) = RTCRayN_org_z(ray, args->N, i) + t * RTCRayN_dir_z(ray, args->N, i) - float(s.center.z);
+            // Embree's geometric normal (which whitted does not read): the sphere's outward
+            // direction; a quadric's is computed by SceneView.
+            const bool sphere = !prims.is_quadric(s);
+            RTCHitN_Ng_x(hit, args->N, i) = sphere ? RTCRayN_org_x(ray, args->N, i) + t * RTCRayN_dir_x(ray, args->N, i) - float(s.center.x) : -RTCRayN_dir_x(ray, args->N, i);
+            RTCHitN_Ng_y(hit, args->N, i) = sphere ? RTCRayN_org_y(ray, args->N, i) + t * RTCRayN_dir_y(ray, args->N, i) - float(s.center.y) : -RTCRayN_dir_y(ray, args->N, i);
+            RTCHitN_Ng_z(hit, args->N, i) = sphere ? RTCRayN_org_z(ray, args->N, i) + t * RTCRayN_dir_z(ray, args->N, i) - float(s.center.z) : -RTCRayN_dir_z(ray, args->N, i);
             RTCHitN_primID(hit, args->N, i) = args->primID;
             RTCHitN_geomID(hit, args->N, i) = args->geomID;
             RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
@@ -258,22 +264,23 @@ void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
     }
 }
 
-/// Shadow rays: both roots in (tnear, tfar] are crossings (in and out).
-void sphere_occluded_fn(const RTCOccludedFunctionNArguments* args) {
-    const auto& spheres = *static_cast<const SpherePrims<float>*>(args->geometryUserPtr);
+/// Shadow rays: every crossing in (tnear, tfar] counts (in and out).
+void analytic_occluded_fn(const RTCOccludedFunctionNArguments* args) {
+    const auto& prims = *static_cast<const AnalyticPrims<float>*>(args->geometryUserPtr);
     auto& q = *reinterpret_cast<QueryContext*>(args->context);
-    const SpherePrims<float>::Item& s = spheres.item(args->primID);
+    const AnalyticPrims<float>::Item& s = prims.item(args->primID);
     const bool opaque = !(s.flags & SurfaceFilter::kNeedsTransmittance);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
         float roots[2];
-        if (!packet_sphere_roots(args->ray, args->N, i, s, roots[0], roots[1])) continue;
+        uint8_t face[2];
+        const int n = packet_crossings(prims, args->ray, args->N, i, s, roots, face);
         const float tnear = RTCRayN_tnear(args->ray, args->N, i);
         float& tfar = RTCRayN_tfar(args->ray, args->N, i);
-        for (uint8_t part = 0; part < 2; ++part) {
+        for (int part = 0; part < n; ++part) {
             const float t = roots[part];
             if (!(t > tnear && t <= tfar)) continue;
-            if (opaque || add_crossing(q, sphere_hit(s, t), part, 1.f)) {
+            if (opaque || add_crossing(q, analytic_hit(s, t, face[part]), uint8_t(part), 1.f)) {
                 tfar = -kInfinity;  // Embree's mark for an occluded ray
                 break;
             }
@@ -409,20 +416,20 @@ public:
             rtcAttachGeometryByID(m_top, g, unsigned(i));
             rtcReleaseGeometry(g);
         }
-        // The spheres: one user geometry with its own callbacks, geometry ID after the instances.
-        m_spheres = SpherePrims<float>(scene, filter);
-        if (m_spheres.size() > 0) {
-            m_sphere_geom_id = unsigned(scene.instances.size());
+        // The spheres and quadrics: one user geometry with its own callbacks, geometry ID after the instances.
+        m_analytic = AnalyticPrims<float>(scene, filter);
+        if (m_analytic.size() > 0) {
+            m_analytic_geom_id = unsigned(scene.instances.size());
             RTCGeometry g = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_USER);
-            rtcSetGeometryUserPrimitiveCount(g, m_spheres.size());
-            rtcSetGeometryUserData(g, &m_spheres);
-            rtcSetGeometryBoundsFunction(g, &sphere_bounds_fn, nullptr);
-            rtcSetGeometryIntersectFunction(g, &sphere_intersect_fn);
-            rtcSetGeometryOccludedFunction(g, &sphere_occluded_fn);
+            rtcSetGeometryUserPrimitiveCount(g, m_analytic.size());
+            rtcSetGeometryUserData(g, &m_analytic);
+            rtcSetGeometryBoundsFunction(g, &analytic_bounds_fn, nullptr);
+            rtcSetGeometryIntersectFunction(g, &analytic_intersect_fn);
+            rtcSetGeometryOccludedFunction(g, &analytic_occluded_fn);
             rtcCommitGeometry(g);
-            rtcAttachGeometryByID(m_top, g, m_sphere_geom_id);
+            rtcAttachGeometryByID(m_top, g, m_analytic_geom_id);
             rtcReleaseGeometry(g);
-            m_sphere_bytes = m_spheres.bytes();
+            m_analytic_bytes = m_analytic.bytes();
         }
         rtcCommitScene(m_top);
         throw_pending("building the scene");
@@ -483,7 +490,7 @@ public:
     /// world-space vertex copies of flattened meshes, Embree's internal buffers), plus the sphere
     /// table; the shared vertex and index arrays belong to the Scene and are not counted.
     AccelStats stats() const override {
-        return {m_build_seconds, size_t(std::max<int64_t>(m_device_bytes.load(), 0)) + m_sphere_bytes};
+        return {m_build_seconds, size_t(std::max<int64_t>(m_device_bytes.load(), 0)) + m_analytic_bytes};
     }
 
 private:
@@ -505,7 +512,7 @@ private:
     Hit to_hit(unsigned geom_id, unsigned inst_id, unsigned prim_id, float t, float u, float v) const {
         Hit h;
         if (geom_id == RTC_INVALID_GEOMETRY_ID) return h;
-        if (geom_id == m_sphere_geom_id) return sphere_hit(m_spheres.item(prim_id), t);
+        if (geom_id == m_analytic_geom_id) return analytic_hit(m_analytic.item(prim_id), t, uint32_t(u));
         h.t = t;
         h.u = u;
         h.v = v;
@@ -611,13 +618,13 @@ private:
     std::vector<RTCScene> m_mesh_scenes;
     std::vector<uint32_t> m_mesh_of_instance;
     size_t m_flattened = 0;  ///< meshes placed in the top level in world space (EmbreeConfig::flatten)
-    SpherePrims<float> m_spheres;                         ///< user data of the sphere geometry
-    unsigned m_sphere_geom_id = RTC_INVALID_GEOMETRY_ID;  ///< its geometry ID in m_top
+    AnalyticPrims<float> m_analytic;                         ///< user data of the sphere geometry
+    unsigned m_analytic_geom_id = RTC_INVALID_GEOMETRY_ID;  ///< its geometry ID in m_top
     std::mutex m_error_mutex;
     std::string m_error;
     double m_build_seconds = 0.0;
     std::atomic<int64_t> m_device_bytes{0};  ///< the memory monitor's count for m_device
-    size_t m_sphere_bytes = 0;               ///< SpherePrims, ours (user data)
+    size_t m_analytic_bytes = 0;               ///< AnalyticPrims, ours (user data)
     int m_packet_width = 4;   ///< EmbreeConfig::packet_width
     bool m_compact = false;   ///< EmbreeConfig::compact: single rays go through one-lane packets
 };

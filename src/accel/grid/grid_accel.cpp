@@ -173,11 +173,11 @@ private:
 std::unique_ptr<Accelerator> create_grid_accelerator(const Scene& scene, const SurfaceFilter& filter,
                                                      const GridConfig& config) {
     using Blas = PrimGrid<TrianglePrims<float>>;
-    using SphereBlas = PrimGrid<SpherePrims<float>>;
+    using SphereBlas = PrimGrid<AnalyticPrims<float>>;
     // The mesh builder outlives this call (update() builds a deformed mesh again): config by value.
     return std::make_unique<TwoLevelAccelerator<float, Blas, SphereBlas>>(
         "grid", scene, filter, [config](const Mesh& m) { return Blas(TrianglePrims<float>(m), config); },
-        [&](SpherePrims<float>&& s) { return SphereBlas(std::move(s), config); }, true);
+        [&](AnalyticPrims<float>&& s) { return SphereBlas(std::move(s), config); }, true);
 }
 
 }  // namespace whitted

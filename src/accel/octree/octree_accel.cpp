@@ -165,11 +165,11 @@ private:
 std::unique_ptr<Accelerator> create_octree_accelerator(const Scene& scene, const SurfaceFilter& filter,
                                                        const OctreeConfig& config) {
     using Blas = PrimOctree<TrianglePrims<float>>;
-    using SphereBlas = PrimOctree<SpherePrims<float>>;
+    using SphereBlas = PrimOctree<AnalyticPrims<float>>;
     // The mesh builder outlives this call (update() builds a deformed mesh again): config by value.
     return std::make_unique<TwoLevelAccelerator<float, Blas, SphereBlas>>(
         "octree", scene, filter, [config](const Mesh& m) { return Blas(TrianglePrims<float>(m), config); },
-        [&](SpherePrims<float>&& s) { return SphereBlas(std::move(s), config); }, true);
+        [&](AnalyticPrims<float>&& s) { return SphereBlas(std::move(s), config); }, true);
 }
 
 }  // namespace whitted

@@ -1,0 +1,26 @@
+// Scenes in the spirit of Eric Haines' Standard Procedural Databases (SPD, 1987), built in code
+// from analytic cylinders, cones, discs and spheres (Scene::quadrics), with the same scenes'
+// quadrics tessellated into meshes for comparison: what `whitted bench quadrics` renders.
+//   - rings: a pyramid of rings, each a closed polygon of cylinders with a sphere at every joint
+//     (SPD "rings"), over a ground disc;
+//   - tree: a branching tree of truncated cones with a sphere at every branch tip (SPD "tree"),
+//     over a ground disc.
+// Classic materials (mirror-like, as the SPD's), three point lights and a camera.
+#pragma once
+
+#include <string>
+
+#include "scene/scene.h"
+
+namespace whitted::app {
+
+/// The scene `name` ("rings" or "tree") at `size` (SPD's size factor: rings 1..; tree depth
+/// 4 + size). Throws whitted::Error for another name.
+Scene make_spd_scene(const std::string& name, int size);
+
+/// The same scene with every cylinder and cone tessellated into `segments` side quads (smooth
+/// side normals, flat caps) and every disc into a `segments`-gon, one mesh instance each (the
+/// shape's object space, placed by its world_from_object).
+Scene tessellate_quadrics(const Scene& scene, int segments);
+
+}  // namespace whitted::app
