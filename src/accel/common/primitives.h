@@ -213,24 +213,38 @@ public:
 
     /// The item's crossings of the ray's line in ascending t (0, 1 or 2; the caller keeps those in
     /// its interval) and the face each crosses: a sphere's two roots (face 0), or a quadric's
-    /// crossings (computed in double).
+    /// crossings (computed in double). kQuadric must be is_quadric(s): each kind gets its own code.
+    template <bool kQuadric>
     int crossings(const Item& s, const Vec3<T>& org, const Vec3<T>& dir, T t[2], uint8_t face[2]) const {
-        if (!is_quadric(s)) {
+        if constexpr (!kQuadric) {
             face[0] = face[1] = 0;
             return sphere_roots(org, dir, s.center, s.radius, t[0], t[1]) ? 2 : 0;
+        } else {
+            double td[2];
+            const int n = quadric_crossings(quadric(s).shape, Vec3d(org), Vec3d(dir), td, face);
+            for (int i = 0; i < n; ++i) t[i] = T(td[i]);
+            return n;
         }
-        double td[2];
-        const int n = quadric_crossings(quadric(s).shape, Vec3d(org), Vec3d(dir), td, face);
-        for (int i = 0; i < n; ++i) t[i] = T(td[i]);
-        return n;
     }
 
     template <class Query>
     bool intersect(const RayData& r, uint32_t slot, uint32_t /*id*/, T tnear, Query& q) const {
         const Item& s = m_items[slot];
+        return is_quadric(s) ? intersect_item<true>(s, r, tnear, q) : intersect_item<false>(s, r, tnear, q);
+    }
+
+private:
+    struct QuadricEntry {
+        QuadricShape shape;
+        Bounds3<T> box;
+    };
+    const QuadricEntry& quadric(const Item& s) const { return m_quadrics[s.geom - m_first_quadric]; }
+
+    template <bool kQuadric, class Query>
+    bool intersect_item(const Item& s, const RayData& r, T tnear, Query& q) const {
         T t[2];
         uint8_t face[2];
-        const int n = crossings(s, r.org, r.dir, t, face);
+        const int n = crossings<kQuadric>(s, r.org, r.dir, t, face);
         if (n == 0) return false;
         q.ctx = InstanceContext{s.geom, kInvalidId, s.flags};
         // Nearer crossing first; the farther one is still reported when the nearer one is outside
@@ -246,13 +260,6 @@ public:
         }
         return false;
     }
-
-private:
-    struct QuadricEntry {
-        QuadricShape shape;
-        Bounds3<T> box;
-    };
-    const QuadricEntry& quadric(const Item& s) const { return m_quadrics[s.geom - m_first_quadric]; }
 
     std::vector<Item> m_items;
     std::vector<QuadricEntry> m_quadrics;  ///< by quadric index (skipped ones stay default)

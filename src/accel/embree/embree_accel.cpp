@@ -216,25 +216,26 @@ void analytic_bounds_fn(const RTCBoundsFunctionArguments* args) {
 }
 
 /// The crossings of ray i of a ray packet with item `s` (AnalyticPrims::crossings).
+template <bool kQuadric>
 int packet_crossings(const AnalyticPrims<float>& prims, RTCRayN* ray, unsigned n, unsigned i,
                      const AnalyticPrims<float>::Item& s, float t[2], uint8_t face[2]) {
     const Vec3f org{RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i), RTCRayN_org_z(ray, n, i)};
     const Vec3f dir{RTCRayN_dir_x(ray, n, i), RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i)};
-    return prims.crossings(s, org, dir, t, face);
+    return prims.crossings<kQuadric>(s, org, dir, t, face);
 }
 
 /// Closest hit: the nearer crossing in (tnear, tfar] that accept() takes, else the farther one.
-void analytic_intersect_fn(const RTCIntersectFunctionNArguments* args) {
-    const auto& prims = *static_cast<const AnalyticPrims<float>*>(args->geometryUserPtr);
+template <bool kQuadric>
+void analytic_intersect(const RTCIntersectFunctionNArguments* args, const AnalyticPrims<float>& prims,
+                        const AnalyticPrims<float>::Item& s) {
     auto& q = *reinterpret_cast<QueryContext*>(args->context);
-    const AnalyticPrims<float>::Item& s = prims.item(args->primID);
     RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, args->N);
     RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, args->N);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
         float roots[2];
         uint8_t face[2];
-        const int n = packet_crossings(prims, ray, args->N, i, s, roots, face);
+        const int n = packet_crossings<kQuadric>(prims, ray, args->N, i, s, roots, face);
         const float tnear = RTCRayN_tnear(ray, args->N, i);
         float& tfar = RTCRayN_tfar(ray, args->N, i);
         const unsigned lane = RTCRayN_id(ray, args->N, i);
@@ -250,12 +251,17 @@ void analytic_intersect_fn(const RTCIntersectFunctionNArguments* args) {
             tfar = t;
             RTCHitN_u(hit, args->N, i) = float(face[r]);  // the face crossed (to_hit: Hit::prim)
             RTCHitN_v(hit, args->N, i) = 0.f;
-            // Embree's geometric normal (which whitted does not read): the sphere's outward
-            // direction; a quadric's is computed by SceneView.
-            const bool sphere = !prims.is_quadric(s);
-            RTCHitN_Ng_x(hit, args->N, i) = sphere ? RTCRayN_org_x(ray, args->N, i) + t * RTCRayN_dir_x(ray, args->N, i) - float(s.center.x) : -RTCRayN_dir_x(ray, args->N, i);
-            RTCHitN_Ng_y(hit, args->N, i) = sphere ? RTCRayN_org_y(ray, args->N, i) + t * RTCRayN_dir_y(ray, args->N, i) - float(s.center.y) : -RTCRayN_dir_y(ray, args->N, i);
-            RTCHitN_Ng_z(hit, args->N, i) = sphere ? RTCRayN_org_z(ray, args->N, i) + t * RTCRayN_dir_z(ray, args->N, i) - float(s.center.z) : -RTCRayN_dir_z(ray, args->N, i);
+            // Embree's geometric normal (which whitted does not read): a sphere's outward
+            // direction; for a quadric, against the ray (SceneView computes its normal).
+            if constexpr (kQuadric) {
+                RTCHitN_Ng_x(hit, args->N, i) = -RTCRayN_dir_x(ray, args->N, i);
+                RTCHitN_Ng_y(hit, args->N, i) = -RTCRayN_dir_y(ray, args->N, i);
+                RTCHitN_Ng_z(hit, args->N, i) = -RTCRayN_dir_z(ray, args->N, i);
+            } else {
+                RTCHitN_Ng_x(hit, args->N, i) = RTCRayN_org_x(ray, args->N, i) + t * RTCRayN_dir_x(ray, args->N, i) - float(s.center.x);
+                RTCHitN_Ng_y(hit, args->N, i) = RTCRayN_org_y(ray, args->N, i) + t * RTCRayN_dir_y(ray, args->N, i) - float(s.center.y);
+                RTCHitN_Ng_z(hit, args->N, i) = RTCRayN_org_z(ray, args->N, i) + t * RTCRayN_dir_z(ray, args->N, i) - float(s.center.z);
+            }
             RTCHitN_primID(hit, args->N, i) = args->primID;
             RTCHitN_geomID(hit, args->N, i) = args->geomID;
             RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
@@ -264,17 +270,24 @@ void analytic_intersect_fn(const RTCIntersectFunctionNArguments* args) {
     }
 }
 
-/// Shadow rays: every crossing in (tnear, tfar] counts (in and out).
-void analytic_occluded_fn(const RTCOccludedFunctionNArguments* args) {
+void analytic_intersect_fn(const RTCIntersectFunctionNArguments* args) {
     const auto& prims = *static_cast<const AnalyticPrims<float>*>(args->geometryUserPtr);
-    auto& q = *reinterpret_cast<QueryContext*>(args->context);
     const AnalyticPrims<float>::Item& s = prims.item(args->primID);
+    if (prims.is_quadric(s)) analytic_intersect<true>(args, prims, s);
+    else analytic_intersect<false>(args, prims, s);
+}
+
+/// Shadow rays: every crossing in (tnear, tfar] counts (in and out).
+template <bool kQuadric>
+void analytic_occluded(const RTCOccludedFunctionNArguments* args, const AnalyticPrims<float>& prims,
+                       const AnalyticPrims<float>::Item& s) {
+    auto& q = *reinterpret_cast<QueryContext*>(args->context);
     const bool opaque = !(s.flags & SurfaceFilter::kNeedsTransmittance);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
         float roots[2];
         uint8_t face[2];
-        const int n = packet_crossings(prims, args->ray, args->N, i, s, roots, face);
+        const int n = packet_crossings<kQuadric>(prims, args->ray, args->N, i, s, roots, face);
         const float tnear = RTCRayN_tnear(args->ray, args->N, i);
         float& tfar = RTCRayN_tfar(args->ray, args->N, i);
         for (int part = 0; part < n; ++part) {
@@ -286,6 +299,13 @@ void analytic_occluded_fn(const RTCOccludedFunctionNArguments* args) {
             }
         }
     }
+}
+
+void analytic_occluded_fn(const RTCOccludedFunctionNArguments* args) {
+    const auto& prims = *static_cast<const AnalyticPrims<float>*>(args->geometryUserPtr);
+    const AnalyticPrims<float>::Item& s = prims.item(args->primID);
+    if (prims.is_quadric(s)) analytic_occluded<true>(args, prims, s);
+    else analytic_occluded<false>(args, prims, s);
 }
 
 /// rtcIntersect4/8/16 and their ray-hit structures by width.
