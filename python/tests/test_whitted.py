@@ -30,6 +30,15 @@ def test_info_is_what_whitted_info_prints(glb):
         assert out == info["text"]
 
 
+def test_scene_file_quadrics_are_counted_and_rendered():
+    scene = whitted.load(os.path.join(ASSETS, "scenes", "quadrics.json"))
+    info = scene.info()
+    assert info["quadrics"] >= 8 and info["triangles"] == 0
+    assert "cylinder[0]" in info["text"] and "disc[" in info["text"]
+    image = whitted.render(scene, width=48, height=30, aa="center", threads=1).beauty
+    assert image.shape == (30, 48, 3) and np.isfinite(image).all() and image.max() > 0.1
+
+
 def test_bad_file_raises_whitted_error_naming_it(tmp_path):
     bad = tmp_path / "broken.gltf"
     # Three positions (36 bytes) declared in a 12-byte buffer.
