@@ -327,7 +327,8 @@ SurfacePoint SceneView::quadric_surface(const Ray& ray, const Hit& hit, const Ra
     sp.p = Vec3f(qp.p);
     sp.p_shadow = sp.p;
     // quadric_crossings solves in double about the quadric's centre: its t error is far below a
-    // float ulp of the point; the unit is that of planes (2^-26 of the object's extent).
+    // float ulp of the point, so the offset unit is the point's own; as for planes, 2^-26 of the
+    // magnitude of the shape's origin keeps it from vanishing next to the world origin.
     sp.offset_scale = float(max_abs(quadric.world_from_object.apply_point({0.0, 0.0, 0.0}))) * 0x1p-26f;
     sp.ng = sp.ns = sp.nc = Vec3f(qp.n);
     if constexpr (!kAttributes) return sp;

@@ -59,7 +59,8 @@ QuadricPoint quadric_point(const Quadric& q, const Vec3d& world, int face) {
     QuadricPoint out;
     Vec3d o = q.object_from_world.apply_point(world);
     Vec3d n_obj{0.0, 0.0, 1.0};
-    // Area scale of the transform: |det|^(2/3), the mean over orientations of a similarity.
+    // Area scale of the transform: |det|^(2/3), exact for a similarity (for other maps a mean
+    // that only sets the texture filter's footprint).
     const double area_scale = std::cbrt(q.world_from_object.det3() * q.world_from_object.det3());
     auto planar = [&](double r) {
         const double rr = r > 0.0 ? r : 1.0;
