@@ -34,7 +34,7 @@ namespace whitted {
 
 /// Object-space shape and inverse transform of a quadric, as the intersection test needs them.
 struct QuadricShape {
-    double m[12];                       ///< object_from_world, rows 0-2 of the affine matrix
+    Mat4d object_from_world;            ///< Scene::Quadric's
     double r0 = 1, r1 = 1, height = 1;  ///< Scene::Quadric radius0, radius1, height
     double inner = 0;                   ///< discs: inner radius
     QuadricKind kind = QuadricKind::Cylinder;
@@ -42,17 +42,8 @@ struct QuadricShape {
 
     QuadricShape() = default;
     explicit QuadricShape(const Quadric& q)
-        : r0(q.radius0), r1(q.radius1), height(q.height), inner(q.inner_radius), kind(q.kind), caps(q.caps) {
-        for (int i = 0; i < 12; ++i) m[i] = q.object_from_world.m[size_t(i)];
-    }
-    Vec3d to_object_point(const Vec3d& p) const {
-        return {m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
-                m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]};
-    }
-    Vec3d to_object_vector(const Vec3d& v) const {
-        return {m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
-                m[8] * v.x + m[9] * v.y + m[10] * v.z};
-    }
+        : object_from_world(q.object_from_world), r0(q.radius0), r1(q.radius1), height(q.height),
+          inner(q.inner_radius), kind(q.kind), caps(q.caps) {}
 };
 
 namespace quadric_detail {
@@ -136,8 +127,8 @@ inline int inside_spans(const SideQuadratic& f, Span out[2]) {
 inline int quadric_crossings(const QuadricShape& q, const Vec3d& world_org, const Vec3d& world_dir, double t[2],
                              uint8_t face[2]) {
     using namespace quadric_detail;
-    const Vec3d o0 = q.to_object_point(world_org);
-    const Vec3d d = q.to_object_vector(world_dir);
+    const Vec3d o0 = q.object_from_world.apply_point(world_org);
+    const Vec3d d = q.object_from_world.apply_vector(world_dir);
     const double dd = dot(d, d);
     if (!(dd > 0.0) || !std::isfinite(dd)) return 0;
     // Re-centre: the origin moves to the line's point nearest the object's centre.
