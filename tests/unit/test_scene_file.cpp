@@ -792,6 +792,10 @@ TEST(SceneFile, BundledFixtures) {
     EXPECT_EQ(w.settings.output, "whitted1980.png");
     EXPECT_TRUE(w.warnings.empty()) << w.warnings[0];
 
+    const Scene q = import_scene_file(std::string(WHITTED_ASSETS_DIR) + "/scenes/quadrics.json");
+    EXPECT_EQ(q.quadrics.size(), 8u);
+    EXPECT_TRUE(q.warnings.empty()) << q.warnings[0];
+
     const Scene e = import_scene_file(fixture("every_key.json"));
     EXPECT_EQ(e.cameras.size(), 2u);  // "cameras": false on the Duck
     EXPECT_EQ(e.settings.camera, 1);
