@@ -892,6 +892,10 @@ void transform_scene(Scene& scene, double s, double t) {
         sp.center = m.apply_point(sp.center);
         sp.radius *= s;
     }
+    for (Quadric& q : scene.quadrics) {
+        q.world_from_object = m * q.world_from_object;
+        q.object_from_world = q.world_from_object.inverse_affine();
+    }
     for (Plane& p : scene.planes) p.point = m.apply_point(p.point);
     for (Light& l : scene.lights) {
         l.position = m.apply_point(l.position);

@@ -207,7 +207,7 @@ QuadricProbeResult probe_quadric(const QuadricProbeConfig& config);
 // 2. Scale and translation invariance of images
 
 /// Uniformly scales the whole scene by s about the world origin and then translates it by
-/// t * kTranslationDir: instances, spheres, planes, lights and cameras (transforms composed in
+/// t * kTranslationDir: instances, spheres, quadrics, planes, lights and cameras (transforms composed in
 /// double). Point and spot intensities are multiplied by s^2, light ranges, Classic attenuation
 /// coefficients (c2 / s, c3 / s^2), absorption (1 / s) and world-space checker sizes adjusted,
 /// so the lighting and the image are those of the original scene. The translation is snapped to

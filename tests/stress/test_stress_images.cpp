@@ -13,7 +13,8 @@
 namespace whitted::stress {
 namespace {
 
-const char* const kScenes[] = {"default.glb", "whitted1980.json", "transparent_shadows.json", "glass_mirror_room.json"};
+const char* const kScenes[] = {"default.glb", "whitted1980.json", "transparent_shadows.json", "glass_mirror_room.json",
+                               "quadrics.json"};
 
 Scene load_bundled(const std::string& name) { return load_scene(std::string(WHITTED_ASSETS_DIR) + "/scenes/" + name); }
 
@@ -71,7 +72,7 @@ TEST(StressImages, ScaleAndTranslationInvariance) {
 // brute, grid and octree (no per-primitive box test). Brute force takes minutes on
 // glass_mirror_room (its boxes) and default.glb: the structures stand in for it there.
 TEST(StressImages, InHouseBackendsAgreeOnSmallBundledScenes) {
-    for (const char* name : {"whitted1980.json", "transparent_shadows.json", "glass_mirror_room.json"}) {
+    for (const char* name : {"whitted1980.json", "transparent_shadows.json", "glass_mirror_room.json", "quadrics.json"}) {
         const bool brute = std::string(name) != "glass_mirror_room.json";
         const Scene scene = load_bundled(name);
         auto render_at = [&](const char* accel) {
