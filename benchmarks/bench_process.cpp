@@ -8,12 +8,6 @@
 // initialisers, argument parsing, tearing down). `whitted --help` and `whitted info` of the
 // first scene are timed the same way. Medians of --repeat runs; prints a table and writes
 // <out>/process.csv.
-#include <spawn.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -29,9 +23,9 @@
 #include <fmt/ranges.h>
 
 #include "benchmarks/bench_commands.h"
+#include "benchmarks/process_run.h"
+#include "benchmarks/versus_povray.h"
 #include "core/error.h"
-
-extern char** environ;
 
 namespace whitted::app {
 
@@ -47,6 +41,8 @@ struct BenchProcessOptions {
     int threads = 0;
     std::string out = "out/bench_process";
     std::string exe;  ///< the whitted to run; empty = this executable
+    bool vs_povray = false;           ///< run the comparison with POV-Ray instead (versus_povray.h)
+    VersusPovrayOptions povray;
 };
 
 std::vector<std::string> default_scenes() {
@@ -74,42 +70,8 @@ struct BenchProcess {
     std::string exe = options.exe.empty() ? whitted_beside_this_program() : options.exe;
 };
 
-/// One complete run: wall time, peak RSS, exit status and what it printed on stderr.
-struct Run {
-    double seconds = 0.0;
-    size_t peak_bytes = 0;
-    int code = 0;
-    std::string err;
-};
-
 Run run_whitted(const std::string& exe, const std::vector<std::string>& args, const fs::path& err_file) {
-    std::vector<std::string> argv_s{"whitted"};
-    argv_s.insert(argv_s.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& a : argv_s) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 2, err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const auto t0 = std::chrono::steady_clock::now();
-    pid_t pid = 0;
-    const int rc = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    if (rc != 0) throw Error(fmt::format("bench process: cannot start whitted: {}", std::strerror(rc)));
-    int status = 0;
-    rusage usage{};
-    while (wait4(pid, &status, 0, &usage) < 0)
-        if (errno != EINTR) throw Error("bench process: wait4 failed");
-    Run r;
-    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    r.peak_bytes = size_t(usage.ru_maxrss) * 1024;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    std::ifstream in(err_file);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    r.err = ss.str();
-    return r;
+    return run_program(exe, "whitted", args, err_file);
 }
 
 /// The phases of a render's summary line ("time   load 0.073s  build 0.000s  render 0.094s  write 0.003s").
@@ -127,11 +89,6 @@ Phases parse_phases(const std::string& err) {
     return p;
 }
 
-double median(std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
 
 struct Row {
     std::string what, scene, size, format;
@@ -145,8 +102,8 @@ Row measure(const std::vector<std::string>& args, const BenchProcess& o, const f
     for (int i = 0; i < o.repeat; ++i) {
         const Run r = run_whitted(o.exe, args, err_file);
         if (r.code != 0) {
-            std::string first_line = r.err.substr(0, r.err.find('\n'));
-            throw Error(fmt::format("bench process: `whitted {}` failed ({}): {}", fmt::join(args, " "), r.code, first_line));
+            throw Error(fmt::format("bench process: `whitted {}` failed ({}): {}", fmt::join(args, " "), r.code,
+                                    first_line(r.err)));
         }
         wall.push_back(r.seconds);
         peak.push_back(double(r.peak_bytes));
@@ -187,6 +144,14 @@ std::vector<std::string> split_commas(const std::string& s) {
 }
 
 int run_bench_process(const BenchProcessOptions& options) {
+    if (options.vs_povray) {
+        VersusPovrayOptions v = options.povray;
+        v.whitted = options.exe.empty() ? whitted_beside_this_program() : options.exe;
+        v.repeat = options.repeat;
+        v.threads = options.threads;
+        v.out = options.out;
+        return run_versus_povray(v);
+    }
     BenchProcess o{options, split_commas(options.sizes), split_commas(options.formats)};
     if (o.sizes.empty() || o.formats.empty()) throw Error("bench process: --sizes and --formats need at least one entry");
     const std::vector<std::string> scenes = o.scenes.empty() ? default_scenes() : o.scenes;
@@ -280,6 +245,21 @@ Command register_bench_process(CLI::App& bench) {
     app->add_option("--out", o->out, "Output directory: process.csv")->capture_default_str();
     app->add_option("--exe", o->exe, "The whitted executable to time (default: the one beside this program; another build for a before/after)")
         ->check(CLI::ExistingFile);
+    app->add_flag("--vs-povray", o->vs_povray,
+                  "Instead: whitted against POV-Ray 3.7 at equal error, whole runs, on the classic scene at 1920x1080 and "
+                  "SPD-style scenes at 512x512 (docs/performance.md, \"Against POV-Ray\")");
+    app->add_option("--povray", o->povray.povray, "--vs-povray: the POV-Ray program (a path, or a name on the PATH)")
+        ->capture_default_str();
+    app->add_option("--pov-scenes", o->povray.scenes, "--vs-povray: scenes: whitted1980, rings, tree")
+        ->delimiter(',')
+        ->check(CLI::IsMember({"whitted1980", "rings", "tree"}))
+        ->capture_default_str();
+    app->add_option("--spd-size", o->povray.spd_size, "--vs-povray: SPD size factor of rings and tree")
+        ->check(CLI::Range(1, 6))
+        ->capture_default_str();
+    app->add_option("--pov-scale", o->povray.scale, "--vs-povray: image sizes times this (1: 1920x1080 and 512x512)")
+        ->check(CLI::Range(0.01, 4.0))
+        ->capture_default_str();
     return Command{app, [o] { return run_bench_process(*o); }};
 }
 
