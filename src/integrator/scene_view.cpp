@@ -322,8 +322,11 @@ SurfacePoint SceneView::quadric_surface(const Ray& ray, const Hit& hit, const Ra
     const Quadric& quadric = m_scene.quadric_of(hit.geom);
     SurfacePoint sp;
     sp.material = quadric.material;
-    // o + t d moved onto the face the ray crossed (Hit::prim) in double (quadric_point), as for spheres.
-    const QuadricPoint qp = quadric_point(quadric, Vec3d(ray.org) + Vec3d(ray.dir) * double(hit.t), int(hit.prim));
+    // o + t d moved onto the face the ray crossed (Hit::prim) in double (quadric_point), as for
+    // spheres; its UVs only where the material reads a texture.
+    const bool uvs = kAttributes && m_needs_uv[quadric.material] != 0;
+    const QuadricPoint qp =
+        quadric_point(quadric, Vec3d(ray.org) + Vec3d(ray.dir) * double(hit.t), int(hit.prim), uvs);
     sp.p = Vec3f(qp.p);
     sp.p_shadow = sp.p;
     // quadric_crossings solves in double about the quadric's centre: its t error is far below a
@@ -332,7 +335,6 @@ SurfacePoint SceneView::quadric_surface(const Ray& ray, const Hit& hit, const Ra
     sp.offset_scale = float(max_abs(quadric.world_from_object.apply_point({0.0, 0.0, 0.0}))) * 0x1p-26f;
     sp.ng = sp.ns = sp.nc = Vec3f(qp.n);
     if constexpr (!kAttributes) return sp;
-    const bool uvs = m_needs_uv[quadric.material] != 0;
     if (uvs) sp.uv[0] = sp.uv[1] = Vec2f{float(qp.u), float(qp.v)};
     const float width = cone.width_at(hit.t);
     if (width > 0.f) {

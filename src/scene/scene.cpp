@@ -55,14 +55,15 @@ Quadric make_quadric(QuadricKind kind, const Vec3d& base, const Vec3d& apex, dou
     return q;
 }
 
-QuadricPoint quadric_point(const Quadric& q, const Vec3d& world, int face) {
+QuadricPoint quadric_point(const Quadric& q, const Vec3d& world, int face, bool uvs) {
     QuadricPoint out;
     Vec3d o = q.object_from_world.apply_point(world);
     Vec3d n_obj{0.0, 0.0, 1.0};
     // Area scale of the transform: |det|^(2/3), exact for a similarity (for other maps a mean
     // that only sets the texture filter's footprint).
-    const double area_scale = std::cbrt(q.world_from_object.det3() * q.world_from_object.det3());
+    const double area_scale = uvs ? std::cbrt(q.world_from_object.det3() * q.world_from_object.det3()) : 1.0;
     auto planar = [&](double r) {
+        if (!uvs) return;
         const double rr = r > 0.0 ? r : 1.0;
         out.u = 0.5 + o.x / (2.0 * rr);
         out.v = 0.5 + o.y / (2.0 * rr);
@@ -90,11 +91,13 @@ QuadricPoint quadric_point(const Quadric& q, const Vec3d& world, int face) {
             o.z = zc;
             n_obj = r_side > 0.0 ? Vec3d{o.x, o.y, -k * r_side} : Vec3d{0.0, 0.0, k < 0.0 ? 1.0 : -1.0};
             if (rho == 0.0 && r_side > 0.0) n_obj = {1.0, 0.0, 0.0};  // on the axis: any radial direction
-            out.u = std::atan2(o.y, o.x) / (2.0 * kPiD) + 0.5;
-            out.v = o.z / q.height;
-            const double slant = std::sqrt(q.height * q.height + (q.radius1 - q.radius0) * (q.radius1 - q.radius0));
-            const double r_mean = std::max(r_side, 1e-3 * std::max(q.radius0, q.radius1));
-            out.uv_area = 2.0 * kPiD * r_mean * slant * area_scale;
+            if (uvs) {
+                out.u = std::atan2(o.y, o.x) / (2.0 * kPiD) + 0.5;
+                out.v = o.z / q.height;
+                const double slant = std::sqrt(q.height * q.height + (q.radius1 - q.radius0) * (q.radius1 - q.radius0));
+                const double r_mean = std::max(r_side, 1e-3 * std::max(q.radius0, q.radius1));
+                out.uv_area = 2.0 * kPiD * r_mean * slant * area_scale;
+            }
         } else {
             o.z = out.part == 1 ? 0.0 : q.height;
             n_obj = {0.0, 0.0, out.part == 1 ? -1.0 : 1.0};

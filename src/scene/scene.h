@@ -121,7 +121,8 @@ struct QuadricPoint {
 /// The surface point of `q` nearest a world point near it (a hit point o + t d carries the error
 /// of t): the object-space point is moved onto `face` (QuadricPoint::part: the face the ray
 /// crossed, Hit::prim) or, for face < 0, onto the side or cap it lies closest to, in double.
-QuadricPoint quadric_point(const Quadric& q, const Vec3d& world, int face = -1);
+/// `uvs` false leaves u, v and uv_area at their defaults (a material that reads no texture).
+QuadricPoint quadric_point(const Quadric& q, const Vec3d& world, int face = -1, bool uvs = true);
 
 /// Infinite plane (scene files): the points p with dot(normal, p - point) = 0. It has no finite
 /// bounds, so it is kept out of every acceleration structure and tested on its own beside them.

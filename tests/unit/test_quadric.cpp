@@ -211,5 +211,53 @@ TEST(Quadric, DegenerateInputGivesNoCrossing) {
     EXPECT_EQ(crossings(q, {INFINITY, 0.5, -3}, {0, 0, 1}, t), 0);
 }
 
+// The world-space axis bound (QuadricShape::line_misses) only drops lines the full test misses:
+// lines aimed at points within 1.5 reach of the axis, most of them just outside the shape,
+// for cylinders and cones under rigid, scaled and sheared transforms and far from the origin.
+TEST(Quadric, AxisBoundRejectsOnlyMisses) {
+    Mat4d shear = Mat4d::identity();
+    shear(0, 1) = 0.7;
+    shear(2, 0) = -0.4;
+    Mat4d scale = Mat4d::identity();
+    scale(0, 0) = 3.0;
+    scale(2, 2) = 0.25;
+    Mat4d far = Mat4d::identity();
+    far(0, 3) = 1e5;
+    far(1, 3) = -3e4;
+    const std::vector<Quadric> shapes{
+        make_quadric(K::Cylinder, {0, 0, 0}, {0.3, 2, 0.1}, 0.5, 0.5, true),
+        make_quadric(K::Cylinder, {1, 0, 0}, {1, 0, 3}, 0.2, 0.2, false, shear),
+        make_quadric(K::Cone, {0, 0, 0}, {0, 0, 1}, 0.8, 0.1, true, scale),
+        make_quadric(K::Cone, {0, 0, 0}, {1, 1, 1}, 0.0, 0.4, false, far * shear),
+    };
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (const Quadric& q : shapes) {
+        const QuadricShape bounded(q);
+        QuadricShape full = bounded;
+        full.reach = std::numeric_limits<double>::infinity();  // no bound: the full test alone
+        ASSERT_TRUE(std::isfinite(bounded.reach));
+        int rejected = 0, hits = 0;
+        for (int i = 0; i < 20000; ++i) {
+            // A point near the shape's axis segment, a random direction through it.
+            const double z = 0.5 + 0.7 * u(rng);
+            const Vec3d on_axis = q.world_from_object.apply_point({0, 0, z * q.height});
+            const Vec3d target = on_axis + Vec3d{u(rng), u(rng), u(rng)} * (1.5 * bounded.reach);
+            const Vec3d d = normalize(Vec3d{u(rng), u(rng), u(rng)});
+            const Vec3d o = target - d * (10.0 + 5.0 * u(rng));
+            double t_full[2], t_bounded[2];
+            uint8_t f_full[2], f_bounded[2];
+            const int n_full = quadric_crossings(full, o, d, t_full, f_full);
+            const int n_bounded = quadric_crossings(bounded, o, d, t_bounded, f_bounded);
+            ASSERT_EQ(n_bounded, n_full) << "ray " << i;
+            for (int k = 0; k < n_full; ++k) EXPECT_EQ(t_bounded[k], t_full[k]);
+            rejected += bounded.line_misses(o, d);
+            hits += n_full > 0;
+        }
+        EXPECT_GT(rejected, 1000);  // the bound does reject lines
+        EXPECT_GT(hits, 1000);      // and the rays do find the shape
+    }
+}
+
 }  // namespace
 }  // namespace whitted

@@ -32,18 +32,49 @@
 
 namespace whitted {
 
-/// Object-space shape and inverse transform of a quadric, as the intersection test needs them.
+/// Object-space shape and inverse transform of a quadric, as the intersection test needs them,
+/// with a world-space bound that rejects most missing lines before the transform: every point of
+/// a cylinder or cone lies within `reach` of its axis line (axis_origin + s axis_dir).
 struct QuadricShape {
     Mat4d object_from_world;            ///< Scene::Quadric's
     double r0 = 1, r1 = 1, height = 1;  ///< Scene::Quadric radius0, radius1, height
     double inner = 0;                   ///< discs: inner radius
     QuadricKind kind = QuadricKind::Cylinder;
     bool caps = false;
+    Vec3d axis_origin{0.0}, axis_dir{0.0, 0.0, 1.0};  ///< world: the object's origin and unit +Z
+    double reach = std::numeric_limits<double>::infinity();  ///< infinite: no bound (discs)
 
     QuadricShape() = default;
     explicit QuadricShape(const Quadric& q)
         : object_from_world(q.object_from_world), r0(q.radius0), r1(q.radius1), height(q.height),
-          inner(q.inner_radius), kind(q.kind), caps(q.caps) {}
+          inner(q.inner_radius), kind(q.kind), caps(q.caps) {
+        if (kind == QuadricKind::Disc) return;
+        const Mat4d& m = q.world_from_object;
+        const Vec3d c0{m(0, 0), m(1, 0), m(2, 0)}, c1{m(0, 1), m(1, 1), m(2, 1)}, c2{m(0, 2), m(1, 2), m(2, 2)};
+        if (!(dot(c2, c2) > 0.0)) return;
+        axis_origin = {m(0, 3), m(1, 3), m(2, 3)};
+        axis_dir = normalize(c2);
+        // A point x c0 + y c1 + z c2 (x^2 + y^2 <= r^2) is |x c0 + y c1| <= sigma r from the axis
+        // line, sigma the largest singular value of [c0 c1] (any affine map, shears included).
+        const double g00 = dot(c0, c0), g11 = dot(c1, c1), g01 = dot(c0, c1);
+        const double half = 0.5 * (g00 - g11);
+        const double sigma = std::sqrt(0.5 * (g00 + g11) + std::sqrt(half * half + g01 * g01));
+        reach = sigma * std::max(r0, r1);
+        if (!std::isfinite(reach)) reach = std::numeric_limits<double>::infinity();
+    }
+
+    /// True when the line o + t d passes farther than `reach` from the axis line (with a margin
+    /// far above the rounding of this test): it cannot cross the shape. False when unsure (a
+    /// line parallel to the axis, a disc).
+    bool line_misses(const Vec3d& o, const Vec3d& d) const {
+        const Vec3d n = cross(d, axis_dir);
+        const double nn = dot(n, n);
+        if (!(nn > 1e-12 * dot(d, d))) return false;  // (nearly) parallel: no bound from this
+        const Vec3d w = o - axis_origin;
+        const double wn = dot(w, n);
+        const double limit = reach * (1.0 + 1e-9) + 1e-12 * (std::fabs(w.x) + std::fabs(w.y) + std::fabs(w.z));
+        return wn * wn > limit * limit * nn;  // |w.n| / |n|, the lines' distance, beyond the limit
+    }
 };
 
 namespace quadric_detail {
@@ -127,6 +158,7 @@ inline int inside_spans(const SideQuadratic& f, Span out[2]) {
 inline int quadric_crossings(const QuadricShape& q, const Vec3d& world_org, const Vec3d& world_dir, double t[2],
                              uint8_t face[2]) {
     using namespace quadric_detail;
+    if (q.line_misses(world_org, world_dir)) return 0;
     const Vec3d o0 = q.object_from_world.apply_point(world_org);
     const Vec3d d = q.object_from_world.apply_vector(world_dir);
     const double dd = dot(d, d);
