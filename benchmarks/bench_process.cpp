@@ -250,9 +250,11 @@ Command register_bench_process(CLI::App& bench) {
                   "SPD-style scenes at 512x512 (docs/performance.md, \"Against POV-Ray\")");
     app->add_option("--povray", o->povray.povray, "--vs-povray: the POV-Ray program (a path, or a name on the PATH)")
         ->capture_default_str();
-    app->add_option("--pov-scenes", o->povray.scenes, "--vs-povray: scenes: whitted1980, rings, tree")
+    app->add_option("--pov-scenes", o->povray.scenes,
+                    "--vs-povray: scenes: whitted1980, rings, tree, or classic scene files (spheres, cylinders, cones, "
+                    "discs, meshes, planes, classic materials, point and directional lights)")
         ->delimiter(',')
-        ->check(CLI::IsMember({"whitted1980", "rings", "tree"}))
+        ->check(CLI::IsMember({"whitted1980", "rings", "tree"}) | CLI::ExistingFile)
         ->capture_default_str();
     app->add_option("--spd-size", o->povray.spd_size, "--vs-povray: SPD size factor of rings and tree")
         ->check(CLI::Range(1, 6))

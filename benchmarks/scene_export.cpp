@@ -306,11 +306,16 @@ std::string to_povray(const Scene& scene, const ExportSettings& s) {
     };
     // whitted evaluates a world-space checker a tiny step inside the surface (so an axis-aligned
     // face does not sit on the cells' boundary); POV-Ray at the point itself. A flat mesh with
-    // such a checker gets its pigment moved by the same step along its normal: the same squares.
+    // such a checker (and a plane) gets its pigment moved by the same step along its normal: the
+    // same squares.
+    auto shift_along = [&](uint32_t material, const Vec3d& normal) -> std::string {
+        const Checker* checker = classic_material(scene, scene.materials[material]);
+        if (!checker) return {};
+        return " translate " + pv(normal * (1e-4 * double(checker->size)));
+    };
     auto checker_shift = [&](const Instance& in) -> std::string {
         const Mesh& mesh = scene.meshes[in.mesh];
-        const Checker* checker = classic_material(scene, scene.materials[mesh.material]);
-        if (!checker || mesh.triangle_count() == 0) return {};
+        if (!classic_material(scene, scene.materials[mesh.material]) || mesh.triangle_count() == 0) return {};
         std::optional<Vec3d> normal;
         const uint32_t inst = uint32_t(&in - scene.instances.data());
         for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
@@ -320,7 +325,7 @@ std::string to_povray(const Scene& scene, const ExportSettings& s) {
             if (!normal) normal = n;
             else if (length(n - *normal) > 1e-9) return {};
         }
-        return " translate " + pv(*normal * (1e-4 * double(checker->size)));
+        return shift_along(mesh.material, *normal);
     };
     for (size_t i = 0; i < scene.spheres.size(); ++i) {
         const Sphere& sp = scene.spheres[i];
@@ -361,7 +366,8 @@ std::string to_povray(const Scene& scene, const ExportSettings& s) {
     }
     for (const Plane& p : scene.planes)
         out += fmt::format("plane {{ {}, {} {} }}\n", pv(p.normal), dot(p.normal, p.point),
-                           material(p.material, scene.materials[p.material].classic.ior));
+                           material(p.material, scene.materials[p.material].classic.ior,
+                                    shift_along(p.material, p.normal)));
     return out;
 }
 

@@ -28,6 +28,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
+const std::string kWhitted1980 = std::string(WHITTED_SOURCE_DIR) + "/assets/scenes/whitted1980.json";
+
 /// One anti-aliasing setting of one program: its label and the arguments that select it.
 struct Setting {
     std::string label;
@@ -143,19 +145,22 @@ int run_versus_povray(const VersusPovrayOptions& o) {
                 o.repeat, povray.c_str());
 
     for (const std::string& name : o.scenes) {
+        // The SPD-style scenes at 512x512; the classic scene and other scene files at their own
+        // size (render.width/height), else 1920x1080.
         Scene scene;
         int width = 512, height = 512;
-        if (name == "whitted1980") {
-            scene = import_scene_file(std::string(WHITTED_SOURCE_DIR) + "/assets/scenes/whitted1980.json");
-            width = 1920;
-            height = 1080;
-        } else {
+        if (name == "rings" || name == "tree") {
             scene = make_spd_scene(name, o.spd_size);
+        } else {
+            scene = import_scene_file(name == "whitted1980" ? kWhitted1980 : name);
+            width = scene.settings.width.value_or(1920);
+            height = scene.settings.height.value_or(scene.settings.width ? width * 9 / 16 : 1080);
         }
+        const std::string label = name == "whitted1980" || name == "rings" || name == "tree" ? name : fs::path(name).stem().string();
         width = std::max(8, int(std::lround(width * o.scale)));
         height = std::max(8, int(std::lround(height * o.scale)));
         const ExportSettings es = export_settings(scene, width, height);
-        const fs::path json = dir / (name + ".json"), pov = dir / (name + ".pov");
+        const fs::path json = dir / (label + ".json"), pov = dir / (label + ".pov");
         std::ofstream(json) << to_scene_file(scene, es);
         std::ofstream(pov) << to_povray(scene, es);
 
@@ -180,7 +185,7 @@ int run_versus_povray(const VersusPovrayOptions& o) {
                         },
                         dir};
         std::printf("\n== %s: %dx%d, %zu spheres, %zu quadrics, %zu triangles, %zu lights, max depth %d, min_weight %.5f\n",
-                    name.c_str(), width, height, scene.spheres.size(), scene.quadrics.size(),
+                    label.c_str(), width, height, scene.spheres.size(), scene.quadrics.size(),
                     scene.instanced_triangle_count(), scene.lights.size(), es.max_depth, double(es.min_weight));
         std::fflush(stdout);
 
@@ -196,21 +201,21 @@ int run_versus_povray(const VersusPovrayOptions& o) {
         std::array<std::vector<uint8_t>, 2> refs;
         for (size_t k = 0; k < sides.size(); ++k) {
             Side& side = sides[k];
-            const fs::path ref_image = dir / fmt::format("{}_{}_reference.png", name, side.program.name);
+            const fs::path ref_image = dir / fmt::format("{}_{}_reference.png", label, side.program.name);
             const Point r = timed(side.program, side.reference.label, side.reference.args, ref_image, 1, err_file);
             const std::vector<uint8_t>& ref = refs[k] = read_rgb8(ref_image, width, height);
             std::printf("   %-8s reference %-22s %8.3fs %8.3fs cpu\n", side.program.name.c_str(), r.label.c_str(), r.seconds,
                         r.cpu_seconds);
             for (size_t k = 0; k < side.settings.size(); ++k) {
                 const Setting& st = side.settings[k];
-                const fs::path image = dir / fmt::format("{}_{}_{}.png", name, side.program.name, k);
+                const fs::path image = dir / fmt::format("{}_{}_{}.png", label, side.program.name, k);
                 Point p = timed(side.program, st.label, st.args, image, o.repeat, err_file);
                 p.psnr = psnr(read_rgb8(image, width, height), ref);
                 side.points.push_back(p);
                 std::printf("   %-8s %-31s %8.3fs %8.3fs cpu %7s dB\n", side.program.name.c_str(), st.label.c_str(),
                             p.seconds, p.cpu_seconds, db(p.psnr).c_str());
                 std::fflush(stdout);
-                csv << fmt::format("{},{},{},{},{},{:.4f},{:.4f},{},{}\n", name, width, height, side.program.name,
+                csv << fmt::format("{},{},{},{},{},{:.4f},{:.4f},{},{}\n", label, width, height, side.program.name,
                                    st.label, p.seconds, p.cpu_seconds, db(p.psnr), o.repeat);
             }
         }
