@@ -107,6 +107,32 @@ TEST(BenchEnvCli, CsvColumnsReferenceRowAndAListedDefault) {
     EXPECT_LT(num(split[1], "random_max_all_pct"), 25.0);  // 16 lights, the default rule: 14.8 % over the six maps
 }
 
+// --path-reference: the occlusion sweep's budgets against the path tracer on the generated scene
+// (default.glb has punctual lights: said and skipped), a row per budget, the targets line.
+TEST(BenchEnvCli, PathReferenceComparesEveryBudget) {
+    const fs::path out = whitted::test::scratch_dir("whitted_bench_env_cli", "path");
+    const Result r = run("bench env '" + kBox + "' --maps studio --lights 0 --reference 0 --width 32 --repeat 1 "
+                         "--no-overhead --no-split --no-plot --occlusion 0,36 --occlusion-reference 64 "
+                         "--occlusion-maps furnace --path-reference 16 --out '" + out.string() + "'");
+    ASSERT_EQ(r.code, 0) << r.out << r.err;
+    std::vector<std::string> header;
+    const std::vector<Row> rows = read_csv(out / "env_path_reference.csv", &header);
+    for (const char* column : {"scene", "map", "budget", "path_spp", "psnr_display", "mean_ratio", "seconds",
+                               "path_seconds", "time_ratio"})
+        EXPECT_NE(std::find(header.begin(), header.end(), column), header.end()) << column;
+    ASSERT_EQ(rows.size(), 3u);  // budgets 0, 36 and 64 on the generated scene only
+    for (const Row& row : rows) {
+        EXPECT_EQ(row.at("scene"), "occlusion");
+        EXPECT_GT(num(row, "psnr_display"), 15.0);
+        EXPECT_GT(num(row, "mean_ratio"), 0.8);
+        EXPECT_LT(num(row, "mean_ratio"), 1.2);
+        EXPECT_GT(num(row, "path_seconds"), 0.0);
+    }
+    EXPECT_NE(r.out.find("targets at budget 36: mean"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("path tracer: not run (3 punctual light(s)"), std::string::npos) << r.out;
+    EXPECT_TRUE(fs::exists(out / "occlusion-occlusion-furnace-path16.png"));
+}
+
 TEST(BenchEnvCli, NegativeCountIsOneErrorLine) {
     const fs::path out = whitted::test::scratch_dir("whitted_bench_env_cli", "bad");
     const Result r = run("bench env '" + kBox + "' --lights 0,-1 --width 16 --no-plot --no-overhead --out '" + out.string() + "'");
