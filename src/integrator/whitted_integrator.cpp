@@ -138,7 +138,8 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
                 if (layered && layers.coat_roughness >= kGlossyRayRoughness) stake += layers.coat_kg;
             }
             visible = environment_visibility(s, stake * m_ambient_max, counters);
-            ambient *= visible;
+            // The diffuse ambient also gets back what the occluders reflect (multi-bounce fit).
+            ambient *= multibounce_visibility(visible, c.kd);
         }
         if constexpr (K.layers)
             if (layered) ambient += behind;

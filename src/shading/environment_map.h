@@ -10,6 +10,7 @@
 // +Y by rotation_deg (right-hand rule): world = R_y(rotation) * map-local.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -60,6 +61,24 @@ inline Color sh9_irradiance(const SH9& sh, const Vec3f& n) {
                     (sh[4] * (x * y) + sh[5] * (y * z) + sh[7] * (x * z)) * c2 + sh[6] * (c20 * (3.f * z * z - 1.f)) +
                     sh[8] * (c22 * (x * x - y * y));
     return vmax(e, Color(0.f));
+}
+
+/// The light an occluded point still receives from the scene's interreflection, from its
+/// visibility alone: Jimenez et al.'s multi-bounce fit ("Practical Real-Time Strategies for
+/// Accurate Indirect Occlusion", 2016, eq. 10), per channel of the receiver's albedo, which stands
+/// in for its neighbours'. The ambient visibility v becomes max(v, ((a v + b) v + c) v) with
+/// a = 2.0404 rho - 0.3324, b = -4.7951 rho + 0.6417, c = 2.7552 rho + 0.6903: 0 stays 0 (a closed
+/// room stays dark), 1 stays exactly 1, a black receiver keeps v.
+inline float multibounce_visibility(float v, float albedo) {
+    if (!(v > 0.f)) return 0.f;
+    if (v >= 1.f) return 1.f;
+    const float rho = std::clamp(albedo, 0.f, 1.f);
+    const float a = 2.0404f * rho - 0.3324f, b = -4.7951f * rho + 0.6417f, c = 2.7552f * rho + 0.6903f;
+    return std::clamp(((a * v + b) * v + c) * v, v, 1.f);
+}
+inline Color multibounce_visibility(const Color& v, const Color& albedo) {
+    return {multibounce_visibility(v.x, albedo.x), multibounce_visibility(v.y, albedo.y),
+            multibounce_visibility(v.z, albedo.z)};
 }
 
 /// One light cut from the environment's brightest part (one median-cut region).

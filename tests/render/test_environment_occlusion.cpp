@@ -10,6 +10,7 @@
 #include "importers/scene_loader.h"
 #include "integrator/render.h"
 #include "scene/scene_builder.h"
+#include "shading/environment_map.h"
 #include "tests/support/environment_scenes.h"
 
 namespace whitted {
@@ -31,9 +32,12 @@ IntegratorSettings occlusion(int budget) {
 
 /// A white sphere of radius `r` resting on a white infinite plane y = 0 at the origin, seen from
 /// straight above by an orthographic camera covering x, z in [-2, 2], under a uniform map of 1.
-Scene sphere_on_plane(float r) {
+/// Both take ambient ka = 1 and diffuse `kd` (the albedo the multi-bounce fit reads).
+Scene sphere_on_plane(float r, float kd = 1.f) {
     Scene s;
-    const uint32_t m = add_classic_material(s, white());
+    WhittedCoeffs c = white();
+    c.kd = Color(kd);
+    const uint32_t m = add_classic_material(s, c);
     Sphere sphere;
     sphere.center = {0, r, 0};
     sphere.radius = r;
@@ -95,25 +99,49 @@ TEST(EnvironmentOcclusion, InsideAClosedBoxNothingArrives) {
 // hemisphere (the form factor of a sphere wholly above the point's horizon: cos(theta) R^2 / D^2
 // with cos(theta) = R / D, D the distance to the centre); the rest of a uniform map of 1 arrives.
 // The default budget is within 0.025 of that, 256 within 0.01, at distances from just
-// outside the sphere's outline to 3.5 R.
+// outside the sphere's outline to 3.5 R. A black diffuse albedo (kd 0, ambient ka 1) gets back
+// nothing from its neighbours: the plain fraction; a white one (kd 1) the multi-bounce fit of it.
 TEST(EnvironmentOcclusion, ContactShadowHasTheAnalyticSize) {
     const float R = 0.5f;
-    const Scene s = sphere_on_plane(R);
     constexpr int kSize = 200;  // 0.02 world units a pixel
-    for (const auto& [budget, tolerance] : {std::pair{kDefaultEnvOcclusion, 0.025}, std::pair{256, 0.01}}) {
-        SCOPED_TRACE("budget " + std::to_string(budget));
-        const Film film = render(s, occlusion(budget), kSize);
-        // The open value: a corner, far from the sphere (the map's SH projection is not exactly 1).
-        const double corner2 = 2.0 * 1.99 * 1.99 + double(R) * R;
-        const double open = film.beauty[film.index(0, 0)].x / (1.0 - std::pow(double(R) * R / corner2, 1.5));
-        for (const double d : {0.56, 0.6, 0.75, 1.0, 1.25, 1.75}) {
-            const int px = kSize / 2 + int(std::lround(d / 0.02 - 0.5));
-            const double x = (px + 0.5) * 0.02 - 2.0, z = (kSize / 2 + 0.5) * 0.02 - 2.0;
-            const double D2 = x * x + z * z + double(R) * R;
-            const double expected = open * (1.0 - std::pow(double(R) * R / D2, 1.5));
-            EXPECT_NEAR(film.beauty[film.index(px, kSize / 2)].x, expected, tolerance) << "at distance " << x;
+    for (const float kd : {0.f, 1.f}) {
+        const Scene s = sphere_on_plane(R, kd);
+        // What arrives at a point whose unblocked cosine-weighted share is f.
+        auto arrives = [&](double f) { return double(multibounce_visibility(float(f), kd)); };
+        for (const auto& [budget, tolerance] : {std::pair{kDefaultEnvOcclusion, 0.025}, std::pair{256, 0.01}}) {
+            SCOPED_TRACE("kd " + std::to_string(kd) + ", budget " + std::to_string(budget));
+            const Film film = render(s, occlusion(budget), kSize);
+            // The open value: a corner, far from the sphere (the map's SH projection is not exactly 1).
+            const double corner2 = 2.0 * 1.99 * 1.99 + double(R) * R;
+            const double open = film.beauty[film.index(0, 0)].x / arrives(1.0 - std::pow(double(R) * R / corner2, 1.5));
+            for (const double d : {0.56, 0.6, 0.75, 1.0, 1.25, 1.75}) {
+                const int px = kSize / 2 + int(std::lround(d / 0.02 - 0.5));
+                const double x = (px + 0.5) * 0.02 - 2.0, z = (kSize / 2 + 0.5) * 0.02 - 2.0;
+                const double D2 = x * x + z * z + double(R) * R;
+                const double fraction = 1.0 - std::pow(double(R) * R / D2, 1.5);
+                EXPECT_NEAR(film.beauty[film.index(px, kSize / 2)].x, open * arrives(fraction), tolerance)
+                    << "at distance " << x;
+                if (kd > 0.f && fraction < 0.9)  // the neighbours' light is visible
+                    EXPECT_GT(film.beauty[film.index(px, kSize / 2)].x, open * fraction + 0.03) << "at distance " << x;
+            }
         }
     }
+}
+
+// Jimenez et al.'s multi-bounce fit at hand-computed values: the ends stay put, a black
+// receiver keeps its visibility, v = 0.5 with albedo 0.8 gives
+// ((1.29992 * 0.5 - 3.19438) * 0.5 + 2.89446) * 0.5 = 0.811125.
+TEST(EnvironmentOcclusion, MultibounceFitAtKnownValues) {
+    EXPECT_EQ(multibounce_visibility(0.f, 0.8f), 0.f);
+    EXPECT_EQ(multibounce_visibility(1.f, 0.8f), 1.f);
+    EXPECT_EQ(multibounce_visibility(1.f, 1.f), 1.f);
+    for (const float v : {0.1f, 0.3f, 0.5f, 0.9f}) EXPECT_NEAR(multibounce_visibility(v, 0.f), v, 1e-6f);
+    EXPECT_NEAR(multibounce_visibility(0.5f, 0.8f), 0.811125f, 1e-5f);
+    EXPECT_EQ(multibounce_visibility(std::nanf(""), 0.8f), 0.f);
+    const Color c = multibounce_visibility(Color(0.5f), Color(0.f, 0.8f, 2.f));  // albedo clamped to [0, 1]
+    EXPECT_NEAR(c.x, 0.5f, 1e-6f);
+    EXPECT_NEAR(c.y, 0.811125f, 1e-5f);
+    EXPECT_NEAR(c.z, multibounce_visibility(0.5f, 1.f), 1e-6f);
 }
 
 // The same image for 1 thread and 16-pixel tiles as for 2 threads and 64-pixel tiles, with
