@@ -76,7 +76,7 @@ struct BenchEnvOptions {
     std::vector<std::string> split_maps;                   ///< its maps; empty = every bundled one
     std::vector<int> split_counts{4, 16, 64, 128, 256};    ///< its light counts
     int split_normals = 100;                               ///< random normals its error is measured at (besides the 6 axes)
-    std::vector<int> occlusion{0, 4, 16, 36, 64};           ///< --env-occlusion budgets compared (0 = off)
+    std::vector<int> occlusion{0, 4, 9, 16, 25, 36, 64};   ///< --env-occlusion budgets compared (0 = off)
     int occlusion_reference = 1024;                        ///< the budget they are compared against
     std::vector<std::string> occlusion_maps{"furnace", "studio", "courtyard"};  ///< environments of the occlusion sweep
     std::vector<std::string> occlusion_scenes;             ///< its scenes; empty = the generated occlusion scene and default.glb

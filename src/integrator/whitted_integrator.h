@@ -29,7 +29,7 @@ namespace whitted {
 
 /// Default of --env-occlusion: directions per shading point over which the environment's ambient
 /// is occluded (docs/environment.md, "Occlusion"); the glossy rays are a quarter of it.
-constexpr int kDefaultEnvOcclusion = 36;
+constexpr int kDefaultEnvOcclusion = 25;
 /// Levels of sub-cells an occlusion cell on an occluder's edge is refined into (2: 16 sub-cells).
 constexpr int kOcclusionLevels = 2;
 /// Glossy reflection rougher than this takes the prefiltered map times the ambient's visibility

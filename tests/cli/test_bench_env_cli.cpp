@@ -112,7 +112,7 @@ TEST(BenchEnvCli, CsvColumnsReferenceRowAndAListedDefault) {
 TEST(BenchEnvCli, PathReferenceComparesEveryBudget) {
     const fs::path out = whitted::test::scratch_dir("whitted_bench_env_cli", "path");
     const Result r = run("bench env '" + kBox + "' --maps studio --lights 0 --reference 0 --width 32 --repeat 1 "
-                         "--no-overhead --no-split --no-plot --occlusion 0,36 --occlusion-reference 64 "
+                         "--no-overhead --no-split --no-plot --occlusion 0,25 --occlusion-reference 64 "
                          "--occlusion-maps furnace --path-reference 16 --out '" + out.string() + "'");
     ASSERT_EQ(r.code, 0) << r.out << r.err;
     std::vector<std::string> header;
@@ -120,7 +120,7 @@ TEST(BenchEnvCli, PathReferenceComparesEveryBudget) {
     for (const char* column : {"scene", "map", "budget", "path_spp", "psnr_display", "mean_ratio", "seconds",
                                "path_seconds", "time_ratio"})
         EXPECT_NE(std::find(header.begin(), header.end(), column), header.end()) << column;
-    ASSERT_EQ(rows.size(), 3u);  // budgets 0, 36 and 64 on the generated scene only
+    ASSERT_EQ(rows.size(), 3u);  // budgets 0, 25 (the default) and 64 on the generated scene only
     for (const Row& row : rows) {
         EXPECT_EQ(row.at("scene"), "occlusion");
         EXPECT_GT(num(row, "psnr_display"), 15.0);
@@ -128,7 +128,7 @@ TEST(BenchEnvCli, PathReferenceComparesEveryBudget) {
         EXPECT_LT(num(row, "mean_ratio"), 1.2);
         EXPECT_GT(num(row, "path_seconds"), 0.0);
     }
-    EXPECT_NE(r.out.find("targets at budget 36: mean"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("targets at budget 25: mean"), std::string::npos) << r.out;  // kDefaultEnvOcclusion
     EXPECT_NE(r.out.find("path tracer: not run (3 punctual light(s)"), std::string::npos) << r.out;
     EXPECT_TRUE(fs::exists(out / "occlusion-occlusion-furnace-path16.png"));
 }
