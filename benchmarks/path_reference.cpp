@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -59,34 +60,170 @@ float smith_visibility(float nl, float nv, float a2) {
     return s > 0.f ? 0.5f / s : 0.f;
 }
 
-/// The material at one hit, as the path needs it.
+/// The material at one hit, as the path needs it, with its lobes' selection probabilities at
+/// this view (in proportion to each lobe's rough weight).
 struct Bsdf {
     Color base;           ///< base colour (linear RGB)
     float metallic = 0.f, roughness = 1.f, transmission = 0.f;
     Color f0_dielectric;  ///< KHR_materials_ior / specular
     float ior = 1.5f;
     bool volume = false;
+    Vec3f N, V, Ng;       ///< shading and geometric normal and the view, on the viewer's side
+    bool front = true;
+    float nv = 1.f, a2 = 1.f;
+    float p_spec = 0.f, p_diff = 0.f, p_trans = 0.f;
+
+    bool delta_spec() const { return roughness < kDeltaRoughness; }
+    /// Whether some lobe is not a delta (light sampling can reach it).
+    bool smooth_part() const { return p_diff > 0.f || (p_spec > 0.f && !delta_spec()); }
 
     /// F at V.H of the specular lobe: the metal's and the dielectric's, mixed by metallic.
     Color fresnel(float vh) const {
         return schlick(base, vh) * metallic + schlick(f0_dielectric, vh) * (1.f - metallic);
     }
+    /// Chooses the lobes' probabilities; false when nothing reflects or transmits.
+    bool prepare() {
+        nv = std::max(dot(N, V), 1e-6f);
+        const float a = roughness * roughness;
+        a2 = a * a;
+        const float dielectric = 1.f - metallic;
+        const float fd = max_component(schlick(f0_dielectric, nv));
+        const float w_spec = metallic * max_component(schlick(base, nv)) + dielectric * fd;
+        const float w_diff = dielectric * (1.f - transmission) * (1.f - fd) * luminance(base);
+        const float w_trans = dielectric * transmission * (1.f - fd) * luminance(base);
+        const float total = w_spec + w_diff + w_trans;
+        if (!(total > 0.f)) return false;
+        p_spec = w_spec / total;
+        p_diff = w_diff / total;
+        p_trans = w_trans / total;
+        return true;
+    }
+    /// f cos of the non-delta lobes (rough specular, diffuse) toward unit L on the reflecting side.
+    Color eval(const Vec3f& L) const {
+        const float nl = dot(N, L);
+        if (!(nl > 0.f) || !(dot(L, Ng) > 0.f)) return Color(0.f);
+        const Vec3f H = normalize(L + V);
+        const float vh = std::max(dot(V, H), 0.f), nh = std::max(dot(N, H), 0.f);
+        Color f(0.f);
+        if (!delta_spec()) {
+            const float d = nh * nh * (a2 - 1.f) + 1.f;
+            const float D = a2 / (kPi * d * d);
+            f += fresnel(vh) * (D * smith_visibility(nl, nv, a2) * nl);
+        }
+        const float kd = (1.f - metallic) * (1.f - transmission);
+        if (kd > 0.f) f += base * (Color(1.f) - schlick(f0_dielectric, vh)) * (kd * nl / kPi);
+        return f;
+    }
+    /// The density of the non-delta lobes' sampling toward L (their selection probabilities included).
+    float pdf(const Vec3f& L) const {
+        const float nl = dot(N, L);
+        if (!(nl > 0.f)) return 0.f;
+        float p = p_diff * nl / kPi;
+        if (!delta_spec() && p_spec > 0.f) {
+            const Vec3f H = normalize(L + V);
+            const float vh = dot(V, H), nh = dot(N, H);
+            if (vh > 0.f && nh > 0.f) {
+                const float d = nh * nh * (a2 - 1.f) + 1.f;
+                p += p_spec * (a2 / (kPi * d * d)) * nh / (4.f * vh);
+            }
+        }
+        return p;
+    }
 };
+
+/// Where the path goes next from a surface.
+struct Bounce {
+    Vec3f dir;
+    Color weight;         ///< f cos / pdf (delta lobes: their weight over their probability)
+    float pdf = 0.f;      ///< the non-delta lobes' density toward dir; 0 after a delta lobe
+    bool through = false;  ///< the direction crosses the surface
+};
+
+/// The environment as a distribution of directions: texels in proportion to their luminance
+/// (plus 1/1000 of the mean, so no direction the bilinear lookup lights is impossible) times the
+/// solid angle of their row (Pharr et al., pbrt 3rd ed., 14.2.4).
+class EnvironmentSampler {
+public:
+    EnvironmentSampler(const EnvironmentImage& image, const EnvironmentMap& map)
+        : m_map(map), m_w(image.width), m_h(image.height) {
+        double mean = 0.0;
+        for (const Color& c : image.texels) mean += double(luminance(c));
+        mean /= double(std::max<size_t>(1, image.texels.size()));
+        m_cdf.resize(size_t(m_w + 1) * size_t(m_h));
+        m_rows.resize(size_t(m_h) + 1);
+        for (int y = 0; y < m_h; ++y) {
+            const double sin_theta = std::sin(kPi * (double(y) + 0.5) / double(m_h));
+            double* row = &m_cdf[size_t(y) * size_t(m_w + 1)];
+            row[0] = 0.0;
+            for (int x = 0; x < m_w; ++x)
+                row[x + 1] = row[x] + (double(luminance(image.at(x, y))) + 1e-3 * mean + 1e-30) * sin_theta;
+            m_rows[size_t(y) + 1] = m_rows[size_t(y)] + row[m_w];
+        }
+    }
+    /// A direction (world) and its density per steradian: a texel by its weight, a point
+    /// uniform in (u, v) within it.
+    Vec3f sample(float u0, float u1, float u2, float u3, float& pdf) const {
+        const int y = pick(m_rows.data(), m_h, double(u0) * m_rows.back());
+        const double* row = &m_cdf[size_t(y) * size_t(m_w + 1)];
+        const int x = pick(row, m_w, double(u1) * row[m_w]);
+        const float u = (float(x) + u2) / float(m_w), v = (float(y) + u3) / float(m_h);
+        pdf = density(x, y, v);
+        return m_map.world_from_map(latlong_direction(u, v));
+    }
+    /// The density of sample() toward world direction d.
+    float pdf(const Vec3f& d) const {
+        const Vec2f uv = latlong_uv(m_map.map_from_world(d));
+        const int x = std::clamp(int(uv.x * float(m_w)), 0, m_w - 1), y = std::clamp(int(uv.y * float(m_h)), 0, m_h - 1);
+        return density(x, y, uv.y);
+    }
+
+private:
+    /// The first index i in [0, n) with cdf[i + 1] > target.
+    static int pick(const double* cdf, int n, double target) {
+        const double* it = std::upper_bound(cdf + 1, cdf + n + 1, target);
+        return std::clamp(int(it - (cdf + 1)), 0, n - 1);
+    }
+    /// The texel's probability over the solid angle per unit (u, v) at row position v: texels
+    /// are uniform in (u, v), and d(omega) = 2 pi^2 sin(pi v) du dv.
+    float density(int x, int y, float v) const {
+        const double* row = &m_cdf[size_t(y) * size_t(m_w + 1)];
+        const double p = (row[x + 1] - row[x]) / m_rows.back();
+        const double sin_theta = std::sin(kPi * double(v));
+        if (!(sin_theta > 0.0)) return 0.f;
+        return float(p * double(m_w) * double(m_h) / (2.0 * kPi * kPi * sin_theta));
+    }
+    const EnvironmentMap& m_map;
+    int m_w, m_h;
+    std::vector<double> m_cdf;   ///< per row, the running sum over its texels (width + 1 values)
+    std::vector<double> m_rows;  ///< running sum over the rows' totals (height + 1 values)
+};
+
+/// The power heuristic (beta 2) of density a against b.
+float power_heuristic(float a, float b) {
+    const float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0.f ? a2 / (a2 + b2) : 0.f;
+}
 
 class PathTracer {
 public:
     PathTracer(const Renderer& r, const PathSettings& s)
         : m_view(r.view()), m_accel(r.accelerator()), m_offset(r.accelerator().ray_offset()),
-          m_env(*r.view().environment()), m_settings(s) {}
+          m_env(*r.view().environment()), m_settings(s),
+          m_light(*r.view().scene().environment->image, *r.view().environment()) {}
 
-    /// Radiance along one camera ray.
+    /// Radiance along one camera ray: BSDF sampling and environment sampling combined by
+    /// multiple importance sampling (Veach 1997), one light sample per non-delta vertex.
     Color radiance(Ray ray, Rng& rng, uint64_t& segments) const {
         Color L(0.f), beta(1.f);
         RayKind kind = RayKind::Camera;
+        float bsdf_pdf = 0.f;  // the last bounce's non-delta density; 0: camera ray or a delta lobe
         for (int bounce = 0; bounce < m_settings.max_bounces; ++bounce) {
             ++segments;
             const Hit hit = m_accel.intersect(ray, kind);
-            if (!hit.valid()) return L + beta * m_env.radiance(ray.dir);
+            if (!hit.valid()) {
+                const float w = bsdf_pdf > 0.f ? power_heuristic(bsdf_pdf, m_light.pdf(ray.dir)) : 1.f;
+                return L + beta * m_env.radiance(ray.dir) * w;
+            }
             const SurfacePoint sp = m_view.surface(ray, hit);
             const ShadingFrame f = shading_frame(sp, ray.dir);
             const Material& mat = m_view.scene().materials[sp.material];
@@ -96,6 +233,7 @@ public:
             // BLEND coverage: the path passes the surface with probability 1 - alpha.
             if (mat.alpha_mode == AlphaMode::Blend && rng.uniform() >= in.base_color.w) {
                 ray = spawn_ray(m_offset, sp, -f.Ng, ray.dir);
+                bsdf_pdf = 0.f;  // light sampling treats the surface as blocking: this path alone finds what is behind
                 continue;
             }
             Bsdf b;
@@ -106,15 +244,20 @@ public:
             b.ior = mat.ior;
             b.f0_dielectric = vmin(Color(ior_to_f0(mat.ior)) * in.specular_color, Color(1.f)) * in.specular;
             b.volume = mat.has_volume && mat.thickness > 0.f;
+            b.N = f.N;
+            b.V = f.V;
+            b.Ng = f.Ng;
+            b.front = f.front;
+            if (!b.prepare()) return L;
 
-            Color weight(0.f);
-            Vec3f dir;
-            bool through = false;
-            if (!sample(b, f, rng, weight, dir, through)) return L;
-            beta *= weight;
+            if (b.smooth_part()) L += beta * light_sample(b, sp, rng, segments);
+            Bounce next;
+            if (!sample(b, rng, next)) return L;
+            beta *= next.weight;
             if (!is_finite(beta) || is_black(beta)) return L;
-            ray = spawn_ray(m_offset, sp, through ? -f.Ng : f.Ng, dir);
-            kind = through ? RayKind::Refraction : RayKind::Reflection;
+            bsdf_pdf = next.pdf;
+            ray = spawn_ray(m_offset, sp, next.through ? -f.Ng : f.Ng, next.dir);
+            kind = next.through ? RayKind::Refraction : RayKind::Reflection;
             // Russian roulette after the third bounce, by the path's throughput.
             if (bounce >= 3) {
                 const float q = std::min(0.95f, max_component(beta));
@@ -126,72 +269,73 @@ public:
     }
 
 private:
-    /// Picks one lobe (specular, diffuse, transmission) with a probability in proportion to its
-    /// rough weight at this view and samples a direction from it. `weight` = f cos / (pdf p_lobe).
-    /// False: the path ends (no lobe, or a direction under the geometric surface).
-    bool sample(const Bsdf& b, const ShadingFrame& f, Rng& rng, Color& weight, Vec3f& dir, bool& through) const {
-        const Vec3f& N = f.N;
-        const Vec3f& V = f.V;
-        const float nv = std::max(dot(N, V), 1e-6f);
-        const float dielectric = 1.f - b.metallic;
-        const float fd = max_component(schlick(b.f0_dielectric, nv));
-        const float w_spec = b.metallic * max_component(schlick(b.base, nv)) + dielectric * fd;
-        const float w_diff = dielectric * (1.f - b.transmission) * (1.f - fd) * luminance(b.base);
-        const float w_trans = dielectric * b.transmission * (1.f - fd) * luminance(b.base);
-        const float total = w_spec + w_diff + w_trans;
-        if (!(total > 0.f)) return false;
-        const float u = rng.uniform() * total;
+    /// One direction from the environment's distribution, its light through the non-delta lobes
+    /// if nothing at all is in the way (a transmissive surface blocks it: light through one is
+    /// found by the BSDF's delta lobes, weighted 1), MIS-weighted against the BSDF's density.
+    Color light_sample(const Bsdf& b, const SurfacePoint& sp, Rng& rng, uint64_t& segments) const {
+        float pdf = 0.f;
+        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
+        const Vec3f L = m_light.sample(u0, u1, u2, u3, pdf);
+        if (!(pdf > 0.f)) return Color(0.f);
+        const Color f = b.eval(L);
+        if (is_black(f)) return Color(0.f);
+        const Ray shadow = spawn_ray(m_offset, sp, b.Ng, L);
+        ++segments;
+        if (!(m_accel.transmittance(shadow) == Color(1.f))) return Color(0.f);
+        return f * m_env.radiance(L) * (power_heuristic(pdf, b.pdf(L)) / pdf);
+    }
+
+    /// Picks one lobe (specular, diffuse, transmission) by the probabilities prepare() chose and
+    /// samples a direction from it. A non-delta direction is weighted by all non-delta lobes
+    /// (f cos over their mixture density), a delta one by its own weight over its probability.
+    /// False: the path ends (a direction under the geometric surface).
+    bool sample(const Bsdf& b, Rng& rng, Bounce& out) const {
+        const Vec3f& N = b.N;
+        const Vec3f& V = b.V;
+        const float u = rng.uniform();
         const float u1 = rng.uniform(), u2 = rng.uniform();
         const Basis basis(N);
-        through = false;
-        if (u < w_spec) {
-            const float p = w_spec / total;
-            if (b.roughness < kDeltaRoughness) {
-                dir = reflect(V, N);
-                weight = b.fresnel(nv) / p;
-            } else {
-                // GGX half vector by D(h) N.H: the weight is F V 4 N.L V.H / N.H (D cancels).
-                const float a = b.roughness * b.roughness, a2 = a * a;
+        out.through = false;
+        out.pdf = 0.f;
+        if (u < b.p_spec && b.delta_spec()) {
+            out.dir = reflect(V, N);
+            out.weight = b.fresnel(b.nv) / b.p_spec;
+        } else if (u < b.p_spec + b.p_diff) {
+            if (u < b.p_spec) {
+                // GGX half vector by D(h) N.H, reflected about it.
                 const float phi = 2.f * kPi * u1;
-                const float cos_h = std::sqrt((1.f - u2) / (1.f + (a2 - 1.f) * u2));
+                const float cos_h = std::sqrt((1.f - u2) / (1.f + (b.a2 - 1.f) * u2));
                 const float sin_h = std::sqrt(std::max(0.f, 1.f - cos_h * cos_h));
                 const Vec3f h = basis.world(sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h);
-                const float vh = dot(V, h);
-                if (vh <= 0.f) return false;
-                dir = reflect(V, h);
-                const float nl = dot(N, dir);
-                if (nl <= 0.f) return false;
-                weight = b.fresnel(vh) * (smith_visibility(nl, nv, a2) * 4.f * nl * vh / cos_h / p);
+                if (!(dot(V, h) > 0.f)) return false;
+                out.dir = reflect(V, h);
+            } else {
+                const float r = std::sqrt(u1), phi = 2.f * kPi * u2;
+                out.dir = basis.world(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.f, 1.f - u1)));
             }
-        } else if (u < w_spec + w_diff) {
-            const float p = w_diff / total;
-            // Cosine-weighted: the weight is the albedo times what the dielectric's Fresnel at V.H
-            // leaves to the diffuse layer.
-            const float r = std::sqrt(u1), phi = 2.f * kPi * u2;
-            dir = basis.world(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.f, 1.f - u1)));
-            const Vec3f h = normalize(dir + V);
-            const Color keep = Color(1.f) - schlick(b.f0_dielectric, std::max(dot(V, h), 0.f));
-            weight = b.base * keep * (dielectric * (1.f - b.transmission) / p);
+            out.pdf = b.pdf(out.dir);
+            if (!(out.pdf > 0.f)) return false;
+            out.weight = b.eval(out.dir) / out.pdf;
         } else {
-            const float p = w_trans / total;
-            const Color keep = Color(1.f) - schlick(b.f0_dielectric, nv);
-            weight = b.base * keep * (dielectric * b.transmission / p);
-            through = true;
-            dir = -V;
+            if (!(b.p_trans > 0.f)) return false;
+            const Color keep = Color(1.f) - schlick(b.f0_dielectric, b.nv);
+            out.weight = b.base * keep * ((1.f - b.metallic) * b.transmission / b.p_trans);
+            out.through = true;
+            out.dir = -V;
             if (b.volume) {
                 // Snell at the smooth interface; total internal reflection sends it back.
-                const float eta = f.front ? 1.f / b.ior : b.ior;
+                const float eta = b.front ? 1.f / b.ior : b.ior;
                 if (const auto t = refract(-V, N, eta)) {
-                    dir = *t;
+                    out.dir = *t;
                 } else {
-                    dir = reflect(V, N);
-                    through = false;
+                    out.dir = reflect(V, N);
+                    out.through = false;
                 }
             }
         }
         // Reflected directions under the geometric surface (a shading normal's artefact) end the path.
-        if (!through && dot(dir, f.Ng) <= 0.f) return false;
-        if (through && dot(dir, f.Ng) >= 0.f) return false;
+        if (!out.through && dot(out.dir, b.Ng) <= 0.f) return false;
+        if (out.through && dot(out.dir, b.Ng) >= 0.f) return false;
         return true;
     }
 
@@ -200,6 +344,7 @@ private:
     RayOffsetPolicy m_offset;
     const EnvironmentMap& m_env;
     PathSettings m_settings;
+    EnvironmentSampler m_light;
 };
 
 }  // namespace

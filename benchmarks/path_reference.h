@@ -1,9 +1,11 @@
 // A Monte Carlo path tracer over a Renderer's scene view and accelerator: the converged reference
 // that `whitted bench env --path-reference` holds the occluded environment light against
-// (issue 45's targets). It is a measuring instrument, not a render mode: unidirectional, BSDF
-// sampling only (no light sampling), so it is meant for scenes lit by a smooth environment
-// (the furnace, an overcast sky); it refuses punctual lights, scenes without an environment and
-// classic (scene-file) materials.
+// (issue 45's targets). It is a measuring instrument, not a render mode: unidirectional, with
+// one environment sample per non-delta vertex (texels in proportion to luminance x solid angle)
+// combined with BSDF sampling by multiple importance sampling (power heuristic). It refuses
+// punctual lights, scenes without an environment and classic (scene-file) materials. Light
+// reaching a diffuse surface through a mirror or glass (caustics) is found by BSDF sampling
+// alone, so under maps with small bright lamps it converges slowly.
 //
 // Materials are the glTF 2.0 metallic-roughness BRDF as the specification's Appendix B writes
 // it, not whitted's mapping of it: Lambert diffuse and Smith height-correlated GGX specular,
