@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <atomic>
 #include <mutex>
 #include <numbers>
 
@@ -139,17 +140,20 @@ double sheen_albedo_integral(double cos_v, float alpha) {
 
 /// The albedo table, each row (one sheen roughness) built on first use: a material reads the two
 /// rows about its roughness, so a render computes 2 of the 32 rows, not all of them (about 3 ms
-/// instead of 50-80 ms of start-up). std::call_once makes the first use thread-safe and later
-/// ones an atomic load.
+/// instead of 50-80 ms of start-up). std::call_once makes the first use thread-safe; later uses
+/// read an atomic flag first (libstdc++'s call_once sets up thread-local state on every call, 5 %
+/// of a sheen render when each light's albedo lookup went through it).
 class SheenAlbedoTable {
 public:
     /// Row j (kTableCos values), built if it is not yet.
     const float* row(int j) {
+        if (m_ready[size_t(j)].load(std::memory_order_acquire)) return &m_values[size_t(j * kTableCos)];
         std::call_once(m_built[size_t(j)], [&] {
             // The spec's Lambda fit lets E exceed 1 at grazing, low-roughness views: clamp.
             const float alpha = sq(float(table_roughness(j)));
             for (int i = 0; i < kTableCos; ++i)
                 m_values[size_t(j * kTableCos + i)] = float(std::clamp(sheen_albedo_integral(table_cos(i), alpha), 0.0, 1.0));
+            m_ready[size_t(j)].store(true, std::memory_order_release);
         });
         return &m_values[size_t(j * kTableCos)];
     }
@@ -157,6 +161,7 @@ public:
 private:
     AlbedoTable m_values{};
     std::array<std::once_flag, kTableRough> m_built;
+    std::array<std::atomic<bool>, kTableRough> m_ready{};
 };
 
 SheenAlbedoTable& sheen_albedo_table() {
@@ -206,18 +211,29 @@ float charlie_visibility(float n_dot_l, float n_dot_v, float alpha) {
     return sheen_visibility(cos_l, cos_v, sheen_lambda(cos_v, a), a);
 }
 
-float sheen_albedo(float cos_v, float sheen_roughness) {
-    SheenAlbedoTable& table = sheen_albedo_table();
-    // Continuous table coordinates (column x, row y), the inverses of table_cos() and table_roughness().
+namespace {
+
+/// The two table rows about `sheen_roughness` and the weight between them (row coordinate y, the
+/// inverse of table_roughness()).
+SheenAlbedoRows albedo_rows(float sheen_roughness) {
     const float s0 = min_sheen_roughness();
-    const float x = std::sqrt(clamp01(cos_v)) * float(kTableCos - 1);
     const float y = std::sqrt(clamp01((sheen_roughness - s0) / (1.f - s0))) * float(kTableRough - 1);
-    const int i = std::min(int(x), kTableCos - 2), j = std::min(int(y), kTableRough - 2);
-    const float fx = x - float(i), fy = y - float(j);
-    const float* lo = table.row(j);
-    const float* hi = table.row(j + 1);
-    return mix(mix(lo[i], lo[i + 1], fx), mix(hi[i], hi[i + 1], fx), fy);
+    const int j = std::min(int(y), kTableRough - 2);
+    SheenAlbedoTable& table = sheen_albedo_table();
+    return {table.row(j), table.row(j + 1), y - float(j)};
 }
+
+/// E(cos) between the rows (column coordinate x, the inverse of table_cos()).
+float albedo_between(const SheenAlbedoRows& r, float cos) {
+    const float x = std::sqrt(clamp01(cos)) * float(kTableCos - 1);
+    const int i = std::min(int(x), kTableCos - 2);
+    const float fx = x - float(i);
+    return mix(mix(r.lo[i], r.lo[i + 1], fx), mix(r.hi[i], r.hi[i + 1], fx), r.fy);
+}
+
+}  // namespace
+
+float sheen_albedo(float cos_v, float sheen_roughness) { return albedo_between(albedo_rows(sheen_roughness), cos_v); }
 
 SheenLobe sheen_lobe(float n_dot_v, float sheen_roughness) {
     SheenLobe lobe;
@@ -226,13 +242,14 @@ SheenLobe sheen_lobe(float n_dot_v, float sheen_roughness) {
     lobe.cos_v = clamp_to(n_dot_v, kMinSheenCosine, 1.f);
     lobe.l_half = sheen_l(0.5f, lobe.alpha);
     lobe.lambda_v = sheen_lambda(lobe.cos_v, lobe.alpha, lobe.l_half);
+    lobe.albedo = albedo_rows(lobe.roughness);
     return lobe;
 }
 
 SheenAtLight sheen_at_light(const SheenLobe& lobe, float n_dot_h, float n_dot_l) {
     const float cos_l = clamp_to(n_dot_l, kMinSheenCosine, 1.f);
     const float brdf = charlie_distribution(n_dot_h, lobe.alpha) * sheen_visibility(cos_l, lobe.cos_v, lobe.lambda_v, lobe.alpha, lobe.l_half);
-    return {brdf, sheen_albedo(n_dot_l, lobe.roughness)};
+    return {brdf, albedo_between(lobe.albedo, n_dot_l)};
 }
 
 Color iridescence_fresnel(float cos_theta1, float film_ior, float thickness_nm, const Color& base_f0) {

@@ -37,12 +37,20 @@ float sheen_albedo(float cos_v, float sheen_roughness);
 
 /// The sheen lobe seen from one direction: what D V and the albedo scaling need that does not
 /// depend on the light, computed once per shading point (sheen_lobe) instead of once per light.
+/// The sheen albedo table's two rows about one sheen roughness and the weight between them.
+struct SheenAlbedoRows {
+    const float* lo = nullptr;
+    const float* hi = nullptr;
+    float fy = 0.f;
+};
+
 struct SheenLobe {
     float alpha = 1.f;        ///< clamped to [kMinSheenAlpha, 1]
     float cos_v = 1.f;        ///< N.V clamped to [kMinSheenCosine, 1]
     float lambda_v = 0.f;     ///< Lambda(N.V)
     float l_half = 0.f;       ///< the Lambda fit's log at cos 0.5 (its mirror point)
     float roughness = 1.f;    ///< sheenRoughness (the albedo table's row)
+    SheenAlbedoRows albedo;   ///< the table rows of `roughness`, looked up once per lobe
 };
 SheenLobe sheen_lobe(float n_dot_v, float sheen_roughness);
 
