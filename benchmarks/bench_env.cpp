@@ -381,12 +381,12 @@ double mean_of(const std::vector<float>& v) {
 /// PSNR, mean and time against the path tracer's; the path tracer's own noise (an independent
 /// image of a quarter of the paths) and its PSNR at the default budget's time.
 void against_path_tracer(const BenchEnvOptions& o, const std::string& scene, const std::string& map,
-                         const std::vector<int>& budgets, const std::vector<const Timed*>& runs,
+                         const std::vector<int>& budgets, const std::vector<Timed>& runs,
                          const DisplayTransform& display, std::ofstream& csv, const fs::path& out) {
     const bool cpu_timing = o.timing == "cpu";
-    const Renderer& renderer = *runs.front()->renderer;
-    if (const size_t lights = punctual_lights(renderer.view().scene())) {
-        std::printf("   path tracer: not run (%zu punctual light(s): it samples only the environment)\n", lights);
+    const Renderer& renderer = *runs.front().renderer;
+    if (const std::string why = path_trace_refusal(renderer); !why.empty()) {
+        std::printf("   path tracer: not run (%s)\n", why.c_str());
         return;
     }
     auto trace = [&](int spp, uint64_t seed, double& seconds, PathStats& stats) {
@@ -416,7 +416,7 @@ void against_path_tracer(const BenchEnvOptions& o, const std::string& scene, con
                 o.path_spp, path_seconds, double(path_stats.segments) * 1e-6, quarter, quarter_psnr);
     std::printf("   %6s %9s %7s %12s   against the path tracer\n", "budget", "PSNR[dB]", "mean", "time/path");
     for (size_t k = 0; k < budgets.size(); ++k) {
-        const Timed& t = *runs[k];
+        const Timed& t = runs[k];
         const std::vector<float> linear = packed_rgb(t.film);
         const double psnr = psnr_of(rmse(display_rgb(linear, display), ref_display));
         const double mean = ref_mean > 0.0 ? mean_of(linear) / ref_mean : 1.0;
@@ -514,11 +514,7 @@ void occlusion_sweep(const BenchEnvOptions& o, const fs::path& out) {
                 csv.flush();
                 rows.push_back(std::move(r));
             }
-            if (o.path_spp > 0) {
-                std::vector<const Timed*> budget_runs;
-                for (const Timed& t : timed) budget_runs.push_back(&t);
-                against_path_tracer(o, label_of(path), map, budgets, budget_runs, display, path_csv, out);
-            }
+            if (o.path_spp > 0) against_path_tracer(o, label_of(path), map, budgets, timed, display, path_csv, out);
         }
     }
     // The cheapest budget within 40 dB of the reference on every scene and map.

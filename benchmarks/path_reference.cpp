@@ -16,6 +16,7 @@
 #include "shading/environment_map.h"
 #include "shading/material_mapping.h"
 #include "shading/optics.h"
+#include "shading/sample_sets.h"
 
 namespace whitted::app {
 
@@ -37,17 +38,11 @@ struct Rng {
     float uniform() { return float(next() >> 40) * 0x1p-24f; }
 };
 
-/// An orthonormal basis about unit n (Duff et al. 2017).
+/// An orthonormal basis about unit n (tangent_frame: Duff et al. 2017).
 struct Basis {
     Vec3f t, b, n;
-    explicit Basis(const Vec3f& nn) : n(nn) {
-        const float sign = std::copysign(1.f, n.z);
-        const float a = -1.f / (sign + n.z);
-        const float bb = n.x * n.y * a;
-        t = Vec3f(1.f + sign * n.x * n.x * a, sign * bb, -sign * n.x);
-        b = Vec3f(bb, sign + n.y * n.y * a, -n.y);
-    }
-    Vec3f world(float x, float y, float z) const { return t * x + b * y + n * z; }
+    explicit Basis(const Vec3f& normal) : n(normal) { tangent_frame(n, t, b); }
+    Vec3f world(const Vec3f& d) const { return t * d.x + b * d.y + n * d.z; }
 };
 
 float luminance(const Color& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
@@ -282,7 +277,9 @@ private:
         const Ray shadow = spawn_ray(m_offset, sp, b.Ng, L);
         ++segments;
         if (!(m_accel.transmittance(shadow) == Color(1.f))) return Color(0.f);
-        return f * m_env.radiance(L) * (power_heuristic(pdf, b.pdf(L)) / pdf);
+        // The weight from pdf(L), the function the BSDF's side reads (its texel lookup may round
+        // a direction on a texel's edge into the neighbour), so the two weights sum to 1.
+        return f * m_env.radiance(L) * (power_heuristic(m_light.pdf(L), b.pdf(L)) / pdf);
     }
 
     /// Picks one lobe (specular, diffuse, transmission) by the probabilities prepare() chose and
@@ -303,15 +300,11 @@ private:
         } else if (u < b.p_spec + b.p_diff) {
             if (u < b.p_spec) {
                 // GGX half vector by D(h) N.H, reflected about it.
-                const float phi = 2.f * kPi * u1;
-                const float cos_h = std::sqrt((1.f - u2) / (1.f + (b.a2 - 1.f) * u2));
-                const float sin_h = std::sqrt(std::max(0.f, 1.f - cos_h * cos_h));
-                const Vec3f h = basis.world(sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h);
+                const Vec3f h = basis.world(ggx_half_vector(u1, u2, b.roughness * b.roughness));
                 if (!(dot(V, h) > 0.f)) return false;
                 out.dir = reflect(V, h);
             } else {
-                const float r = std::sqrt(u1), phi = 2.f * kPi * u2;
-                out.dir = basis.world(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.f, 1.f - u1)));
+                out.dir = basis.world(cosine_direction(u1, u2));  // cosine-weighted
             }
             out.pdf = b.pdf(out.dir);
             if (!(out.pdf > 0.f)) return false;
@@ -349,23 +342,22 @@ private:
 
 }  // namespace
 
-size_t punctual_lights(const Scene& scene) {
-    return size_t(std::count_if(scene.lights.begin(), scene.lights.end(), [](const Light& l) { return !l.from_environment; }));
+std::string path_trace_refusal(const Renderer& renderer) {
+    const Scene& scene = renderer.view().scene();
+    if (!renderer.view().environment())
+        return "the scene has no environment (it is meant for environment-lit scenes)";
+    const auto punctual = std::count_if(scene.lights.begin(), scene.lights.end(), [](const Light& l) { return !l.from_environment; });
+    if (punctual > 0)
+        return fmt::format("the scene has {} punctual light(s); the path tracer samples only the environment", punctual);
+    for (const Material& m : scene.materials)
+        if (m.model == MaterialModel::Classic)
+            return fmt::format("material '{}' is a classic Whitted material (it samples glTF materials only)", m.name);
+    return {};
 }
 
 Film path_trace(const Renderer& renderer, const PathSettings& settings, int threads, PathStats* stats) {
+    if (const std::string why = path_trace_refusal(renderer); !why.empty()) throw Error("path reference: " + why);
     const Scene& scene = renderer.view().scene();
-    if (!renderer.view().environment())
-        throw Error("path reference: the scene has no environment (it is meant for environment-lit scenes)");
-    if (const size_t n = punctual_lights(scene))
-        throw Error(fmt::format("path reference: the scene has {} punctual light(s); the path tracer samples only "
-                                "the environment",
-                                n));
-    for (const Material& m : scene.materials)
-        if (m.model == MaterialModel::Classic)
-            throw Error(fmt::format("path reference: material '{}' is a classic Whitted material (it samples glTF "
-                                    "materials only)",
-                                    m.name));
     if (settings.spp < 1) throw Error(fmt::format("path reference: {} paths per pixel", settings.spp));
     const ImageSize size = renderer.image_size();
     const PixelWindow window = renderer.window();

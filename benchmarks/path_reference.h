@@ -22,6 +22,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "film/film.h"
 #include "integrator/render.h"
@@ -41,9 +42,10 @@ struct PathStats {
     double seconds = 0.0;     ///< wall time of the render
 };
 
-/// The scene's lights other than those extracted from its environment (the path tracer sees
-/// those as part of the map).
-size_t punctual_lights(const Scene& scene);
+/// Why path_trace() refuses `renderer`'s scene (no environment, punctual lights other than those
+/// extracted from the environment, which it sees as part of the map, or a classic material), or
+/// empty when it does not.
+std::string path_trace_refusal(const Renderer& renderer);
 
 /// Path-traced image of `renderer`'s scene at its image size and camera, on `threads` workers
 /// (0 = all). Throws whitted::Error when the scene has punctual lights, no environment or a

@@ -129,7 +129,7 @@ TEST(BenchEnvCli, PathReferenceComparesEveryBudget) {
         EXPECT_GT(num(row, "path_seconds"), 0.0);
     }
     EXPECT_NE(r.out.find("targets at budget 25: mean"), std::string::npos) << r.out;  // kDefaultEnvOcclusion
-    EXPECT_NE(r.out.find("path tracer: not run (3 punctual light(s)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("path tracer: not run (the scene has 3 punctual light(s)"), std::string::npos) << r.out;
     EXPECT_TRUE(fs::exists(out / "occlusion-occlusion-furnace-path16.png"));
 }
 
