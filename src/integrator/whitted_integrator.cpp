@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/radix_sort.h"
 #include "core/uninitialized.h"
 #include "integrator/contacts.h"
 #include "shading/local_model.h"
@@ -56,7 +57,8 @@ Color adaptive_test(Color sum, size_t n, Potential potential, Test test, float w
         const float key = m > 0.f ? m : 0.f;  // -0 and NaN as 0
         order[j] = uint64_t(~std::bit_cast<uint32_t>(key)) << 32 | uint64_t(j);
     }
-    std::sort(order.begin(), order.end());
+    thread_local std::vector<uint64_t> scratch;
+    sort_by_high_word(order, scratch);  // = std::sort(order): the indices ascend in the input
     auto nth = [&](size_t k) -> const Color& { return potential(uint32_t(order[k])); };
     Color untested(0.f);
     for (size_t k = 0; k < n; ++k) untested += nth(k);
