@@ -1,6 +1,7 @@
 // A stable LSD radix sort of 64-bit values by their high 32 bits: Ward's adaptive test orders
 // every candidate light of a shading point by its potential (under an environment, up to 256 per
-// point, at every hit), and std::sort's comparisons were 5-6 % of such renders.
+// point, at every hit), and std::sort was 8 % of such a render (a one-thread Duck under studio);
+// this takes half that.
 #pragma once
 
 #include <algorithm>
