@@ -45,8 +45,6 @@ struct Basis {
     Vec3f world(const Vec3f& d) const { return t * d.x + b * d.y + n * d.z; }
 };
 
-float luminance(const Color& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
-
 /// Smith's height-correlated visibility V = G / (4 N.L N.V) for GGX (glTF Appendix B).
 float smith_visibility(float nl, float nv, float a2) {
     const float gv = nl * std::sqrt(nv * nv * (1.f - a2) + a2);
@@ -84,8 +82,9 @@ struct Bsdf {
         const float dielectric = 1.f - metallic;
         const float fd = max_component(schlick(f0_dielectric, nv));
         const float w_spec = metallic * max_component(schlick(base, nv)) + dielectric * fd;
-        const float w_diff = dielectric * (1.f - transmission) * (1.f - fd) * luminance(base);
-        const float w_trans = dielectric * transmission * (1.f - fd) * luminance(base);
+        const float lum = float(luminance(base));
+        const float w_diff = dielectric * (1.f - transmission) * (1.f - fd) * lum;
+        const float w_trans = dielectric * transmission * (1.f - fd) * lum;
         const float total = w_spec + w_diff + w_trans;
         if (!(total > 0.f)) return false;
         p_spec = w_spec / total;
@@ -100,11 +99,7 @@ struct Bsdf {
         const Vec3f H = normalize(L + V);
         const float vh = std::max(dot(V, H), 0.f), nh = std::max(dot(N, H), 0.f);
         Color f(0.f);
-        if (!delta_spec()) {
-            const float d = nh * nh * (a2 - 1.f) + 1.f;
-            const float D = a2 / (kPi * d * d);
-            f += fresnel(vh) * (D * smith_visibility(nl, nv, a2) * nl);
-        }
+        if (!delta_spec()) f += fresnel(vh) * (ggx_distribution(nh * nh, a2) * smith_visibility(nl, nv, a2) * nl);
         const float kd = (1.f - metallic) * (1.f - transmission);
         if (kd > 0.f) f += base * (Color(1.f) - schlick(f0_dielectric, vh)) * (kd * nl / kPi);
         return f;
@@ -117,10 +112,7 @@ struct Bsdf {
         if (!delta_spec() && p_spec > 0.f) {
             const Vec3f H = normalize(L + V);
             const float vh = dot(V, H), nh = dot(N, H);
-            if (vh > 0.f && nh > 0.f) {
-                const float d = nh * nh * (a2 - 1.f) + 1.f;
-                p += p_spec * (a2 / (kPi * d * d)) * nh / (4.f * vh);
-            }
+            if (vh > 0.f && nh > 0.f) p += p_spec * ggx_distribution(nh * nh, a2) * nh / (4.f * vh);
         }
         return p;
     }
@@ -142,7 +134,7 @@ public:
     EnvironmentSampler(const EnvironmentImage& image, const EnvironmentMap& map)
         : m_map(map), m_w(image.width), m_h(image.height) {
         double mean = 0.0;
-        for (const Color& c : image.texels) mean += double(luminance(c));
+        for (const Color& c : image.texels) mean += luminance(c);
         mean /= double(std::max<size_t>(1, image.texels.size()));
         m_cdf.resize(size_t(m_w + 1) * size_t(m_h));
         m_rows.resize(size_t(m_h) + 1);
@@ -151,7 +143,7 @@ public:
             double* row = &m_cdf[size_t(y) * size_t(m_w + 1)];
             row[0] = 0.0;
             for (int x = 0; x < m_w; ++x)
-                row[x + 1] = row[x] + (double(luminance(image.at(x, y))) + 1e-3 * mean + 1e-30) * sin_theta;
+                row[x + 1] = row[x] + (luminance(image.at(x, y)) + 1e-3 * mean + 1e-30) * sin_theta;
             m_rows[size_t(y) + 1] = m_rows[size_t(y)] + row[m_w];
         }
     }

@@ -92,6 +92,8 @@ template <typename T> inline bool is_finite(const Vec3<T>& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 inline bool is_black(const Color& c) { return c.x <= 0.f && c.y <= 0.f && c.z <= 0.f; }
+/// Rec. 709 luminance of linear RGB, in double (shares and sums of power).
+inline double luminance(const Color& c) { return 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z); }
 
 /// Axis-aligned bounding box; default-constructed boxes are empty.
 template <typename T>

@@ -1293,17 +1293,10 @@ std::string read_text(const std::string& path, size_t max_memory) {
     return text;
 }
 
-void check_text_size(size_t size, const std::string& path, const ImportOptions& options) {
-    if (size > options.max_memory / kJsonBytesPerByte)
-        throw Error(FileLoc{path, "", 0, 0},
-                    fmt::format("scene file of {} bytes is too large for the memory limit of {} MiB", size,
-                                options.max_memory >> 20));
-}
-
 /// import_scene_file_text on text the document takes over (a file's text is not copied: 81 MB
-/// of a million spheres cost about 0.2 s to copy, most of it the new pages).
+/// of a million spheres cost about 0.2 s to copy, most of it the new pages). The callers have
+/// checked its size against the memory limit (read_text, import_scene_file_text).
 Scene import_owned_text(std::string text, const std::string& path, const ImportOptions& options) {
-    check_text_size(text.size(), path, options);
     if (text.find_first_not_of(" \t\r\n") == std::string::npos)
         throw Error(FileLoc{path, "", 0, 0}, "empty scene file (expected a JSON object)");
     const JsonDocument doc = scene_file::parse_json_document(std::move(text), path);
@@ -1313,7 +1306,10 @@ Scene import_owned_text(std::string text, const std::string& path, const ImportO
 }  // namespace
 
 Scene import_scene_file_text(std::string_view text, const std::string& path, const ImportOptions& options) {
-    check_text_size(text.size(), path, options);  // before the copy
+    if (text.size() > options.max_memory / kJsonBytesPerByte)  // before the copy
+        throw Error(FileLoc{path, "", 0, 0},
+                    fmt::format("scene file of {} bytes is too large for the memory limit of {} MiB", text.size(),
+                                options.max_memory >> 20));
     return import_owned_text(std::string(text), path, options);
 }
 

@@ -163,9 +163,6 @@ std::string render_settings(const SceneRenderSettings& s) {
     return out;
 }
 
-/// Luminance (Rec. 709) of a linear colour, for shares of power.
-double luminance(const Color& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
-
 /// The environment's light: one line with its size, the extracted lights and their share of the
 /// map's power, then (unless every light is listed anyway) the brightest few.
 void describe_environment(const Scene& scene, ReportDetail detail, const std::function<void(const std::string&)>& line) {

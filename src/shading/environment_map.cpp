@@ -24,9 +24,6 @@ constexpr int kPrefilterSamples = 256;
 /// Width of each prefiltered level (height = width / 2), per kPrefilterRoughness.
 constexpr std::array<int, 4> kPrefilterWidth{128, 64, 32, 32};
 
-/// Rec. 709 luminance of linear RGB.
-double luminance(const Color& c) { return 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z); }
-
 /// Solid angle of one texel of row y of a width x height lat-long (exact for the row's band).
 double texel_solid_angle(int y, int width, int height) {
     return kTwoPiD / width * (std::cos(kPiD * y / height) - std::cos(kPiD * (y + 1) / height));
@@ -289,8 +286,7 @@ std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::L
             const float xi1 = (float(s) + 0.5f) / float(kPrefilterSamples), xi2 = radical_inverse2(uint32_t(s));
             const Vec3f h = ggx_half_vector(xi1, xi2, alpha);
             const float cos2 = (1.f - xi1) / (1.f + (a2 - 1.f) * xi1);
-            const float denom = cos2 * (a2 - 1.f) + 1.f;
-            const float pdf = a2 / (kPi * denom * denom) * 0.25f;
+            const float pdf = ggx_distribution(cos2, a2) * 0.25f;
             const float sample_sr = 1.f / (float(kPrefilterSamples) * pdf);
             const float lod = std::max(0.f, 0.5f * std::log2(sample_sr / float(texel_sr)) + 1.f);
             samples[k].push_back({h.x, h.y, h.z, lod});

@@ -51,4 +51,10 @@ HemisphereGrid cosine_grid(int count);
 /// distributed as D(h) cos(theta_h) with alpha = roughness^2.
 Vec3f ggx_half_vector(float xi1, float xi2, float alpha);
 
+/// GGX's D(h) at cos^2(theta_h) = cos2 for a2 = alpha^2: a2 / (pi ((a2 - 1) cos2 + 1)^2).
+inline float ggx_distribution(float cos2, float a2) {
+    const float denom = cos2 * (a2 - 1.f) + 1.f;
+    return a2 / (kPi * denom * denom);
+}
+
 }  // namespace whitted

@@ -106,7 +106,6 @@ Outcome trace_footprint(const std::string& accel, bool box_first) {
     const Vec3d eye = place({0.0, 0.46, 0.9});
     Outcome out;
     RayCounters counters;
-    auto luminance = [](const Color& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; };
     // Floor points strictly inside the footprint (the wall is 0.004 thick): 61 x 7 of them.
     for (int i = 0; i <= 60; ++i)
         for (int j = 0; j <= 6; ++j) {
@@ -183,7 +182,6 @@ TEST_P(DielectricOnFloor, FloorUnderGlassSlabIsSeenThroughIt) {
         rs.integrator.min_weight = 0.f;
         const Scene with = slab_scene(true, slab_first), without = slab_scene(false, slab_first);
         const Film a = Renderer(with, rs).render(), b = Renderer(without, rs).render();
-        auto luminance = [](const Color& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; };
         size_t differ = 0, off = 0;
         double worst = 0.0;
         for (size_t i = 0; i < a.beauty.size(); ++i) {
