@@ -212,6 +212,68 @@ double replay_seconds(const Accelerator& accel, const std::vector<RecordedRay>& 
     return median(t);
 }
 
+/// The rays of `rays` regrouped as a batched integrator would trace them (issue 44, item 1): each
+/// camera query starts a segment (its rays' trees follow it in the log, each thread's log in
+/// order); within a segment the camera query stays first, then the shadow rays toward each light
+/// (the same end point within 1e-4 of its magnitude, or the same direction for rays without an
+/// end) and the reflection and refraction rays of each kind are each one batch query, in order of
+/// first appearance. The same rays, so a replay of both orders bounds what gathering can buy in
+/// traversal alone.
+std::vector<RecordedRay> gathered_order(const std::vector<RecordedRay>& rays) {
+    std::vector<RecordedRay> out;
+    out.reserve(rays.size());
+    struct Group {
+        bool shadow;
+        RayKind kind;
+        bool finite;
+        Vec3f key;  // end point (finite shadow rays) or direction
+        std::vector<size_t> members;
+    };
+    std::vector<Group> groups;
+    auto flush = [&] {
+        for (const Group& g : groups)
+            for (size_t k = 0; k < g.members.size(); ++k) {
+                RecordedRay r = rays[g.members[k]];
+                r.batch = k == 0 ? uint32_t(g.members.size()) : 0u;
+                out.push_back(r);
+            }
+        groups.clear();
+    };
+    for (size_t i = 0; i < rays.size();) {
+        const RecordedRay& r = rays[i];
+        if (!r.shadow && r.kind == RayKind::Camera && r.batch != 0) {  // a new segment
+            flush();
+            const size_t n = std::max<size_t>(1, r.batch);
+            for (size_t k = i; k < i + n && k < rays.size(); ++k) out.push_back(rays[k]);
+            i += n;
+            continue;
+        }
+        const bool finite = r.shadow && std::isfinite(r.ray.tfar);
+        const Vec3f key = finite ? r.ray.org + r.ray.dir * r.ray.tfar : r.ray.dir;
+        Group* into = nullptr;
+        for (Group& g : groups) {
+            if (g.shadow != r.shadow || g.kind != r.kind || g.finite != finite) continue;
+            if (!r.shadow) {
+                into = &g;
+                break;
+            }
+            const float tol = finite ? 1e-4f * std::max(1.f, max_abs(key)) : 0.f;
+            if (max_abs(g.key - key) <= tol) {
+                into = &g;
+                break;
+            }
+        }
+        if (!into) {
+            groups.push_back({r.shadow, r.kind, finite, key, {}});
+            into = &groups.back();
+        }
+        into->members.push_back(i);
+        ++i;
+    }
+    flush();
+    return out;
+}
+
 // ---- (f) the camera pass: general, specialised, specialised + packets ----
 
 /// One centre sample per pixel in tiles of `tile` pixels, each tile row cut into rows of up to 16
@@ -621,6 +683,23 @@ int run_bench_skip(const BenchSkipOptions& o) {
             std::printf("   traversal inside the render: %.1f%% of its time (the rest: shading, surfaces, camera, "
                         "film); the same queries take %.3fx the replay's traversal time\n",
                         100.0 * traversal_share, traversal_vs_replay);
+            // What gathering the trees' rays into batch queries could save in traversal (issue 44,
+            // item 1): the same rays replayed in the recorded order and regrouped, alternately.
+            {
+                const std::vector<RecordedRay> grouped = gathered_order(rays);
+                std::vector<double> as_recorded, regrouped, gain;
+                for (int i = 0; i < std::max(1, o.repeat); ++i) {
+                    as_recorded.push_back(replay_seconds(renderer.accelerator(), rays, threads, 1));
+                    regrouped.push_back(replay_seconds(renderer.accelerator(), grouped, threads, 1));
+                    gain.push_back(regrouped.back() / as_recorded.back());
+                }
+                size_t queries = 0;
+                for (const RecordedRay& r : grouped) queries += r.batch != 0;
+                std::printf("   gathered replay: each camera batch's trees regrouped (shadow rays per light, reflection "
+                            "and refraction rays per kind: %zu queries for %zu rays) %.4fs against %.4fs in the "
+                            "recorded order: %.3fx the time (median of %zu pairs)\n",
+                            queries, grouped.size(), median(regrouped), median(as_recorded), median(gain), gain.size());
+            }
             ocsv << fmt::format("{},{},{},{},{},{},{},{:.6f},{:.4f},{:.6f},{:.4f},{:.4f},{:.2f},{:.4f},{:.4f}\n", label,
                                 threads, g_cpu_clock ? "cpu" : "wall", rays.size(), st.rays.camera, st.rays.shadow,
                                 st.rays.secondary(), render_s, render_mr, replay, replay_mr, ratio, load,

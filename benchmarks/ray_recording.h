@@ -3,7 +3,7 @@
 // real render's secondary rays) can replay exactly the rays a render traced. Batch queries
 // (Accelerator::intersect over a span: the integrator's rows of camera rays) are forwarded as
 // batches and their boundaries kept, so a replay can trace them as batches too (packets where the
-// render used packets).
+// render used packets); batch shadow queries likewise.
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
@@ -40,9 +40,16 @@ inline float replay(const Accelerator& accel, const std::vector<RecordedRay>& ra
             const size_t n = std::min<size_t>(rr.batch, end - i);
             batch.clear();
             for (size_t k = i; k < i + n; ++k) batch.push_back(rays[k].ray);
-            hits.resize(batch.size());
-            accel.intersect(batch, rr.kind, hits);
-            for (const Hit& h : hits) sink += h.t;
+            if (rr.shadow) {
+                thread_local std::vector<Color> through;
+                through.resize(batch.size());
+                accel.transmittance(batch, through);
+                for (const Color& c : through) sink += c.x;
+            } else {
+                hits.resize(batch.size());
+                accel.intersect(batch, rr.kind, hits);
+                for (const Hit& h : hits) sink += h.t;
+            }
             i += n;
         } else {
             sink += rr.shadow ? accel.transmittance(rr.ray).x : accel.intersect(rr.ray, rr.kind).t;
@@ -68,6 +75,12 @@ public:
     Color transmittance(const Ray& ray) const override {
         m_log.local().push_back({ray, RayKind::Shadow, true});
         return m_inner.transmittance(ray);
+    }
+    void transmittance(std::span<const Ray> rays, std::span<Color> out) const override {
+        std::vector<RecordedRay>& log = m_log.local();
+        for (size_t i = 0; i < rays.size(); ++i)
+            log.push_back({rays[i], RayKind::Shadow, true, i == 0 ? uint32_t(rays.size()) : 0u});
+        m_inner.transmittance(rays, out);
     }
     std::string name() const override { return m_inner.name(); }
     RayOffsetPolicy ray_offset() const override { return m_inner.ray_offset(); }
@@ -107,6 +120,11 @@ public:
         const Color c = m_inner.transmittance(ray);
         m_ticks.fetch_add(ticks() - t0, std::memory_order_relaxed);
         return c;
+    }
+    void transmittance(std::span<const Ray> rays, std::span<Color> out) const override {
+        const uint64_t t0 = ticks();
+        m_inner.transmittance(rays, out);
+        m_ticks.fetch_add(ticks() - t0, std::memory_order_relaxed);
     }
     std::string name() const override { return m_inner.name(); }
     RayOffsetPolicy ray_offset() const override { return m_inner.ray_offset(); }

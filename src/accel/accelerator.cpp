@@ -9,4 +9,9 @@ void Accelerator::intersect(std::span<const Ray> rays, RayKind kind, std::span<H
     for (size_t i = 0; i < rays.size(); ++i) hits[i] = intersect(rays[i], kind);
 }
 
+void Accelerator::transmittance(std::span<const Ray> rays, std::span<Color> out) const {
+    RT_CHECK_EQ(rays.size(), out.size());
+    for (size_t i = 0; i < rays.size(); ++i) out[i] = transmittance(rays[i]);
+}
+
 }  // namespace whitted

@@ -145,6 +145,13 @@ public:
     /// crossing counts once (de-duplicated per (geom, inst) within a few-ulp t window). Returns
     /// exactly 0 as soon as an opaque surface is found.
     virtual Color transmittance(const Ray& ray) const = 0;
+    /// Transmittances of a batch of shadow rays (out.size() == rays.size(), else throws): out[i] is
+    /// transmittance(rays[i]), except that the factors of three or more transparent crossings may
+    /// be multiplied in another order (a last-bit difference) and a crossing at exactly a shared
+    /// edge or at tfar may be decided as by a packet. Rays toward one light from neighbouring
+    /// points are what it is for: the Embree backend traces them as packets; the default loops
+    /// over transmittance().
+    virtual void transmittance(std::span<const Ray> rays, std::span<Color> out) const;
     /// Brings the structure up to date after the scene it was built from changed in place as
     /// `update` says (scene_update.h): deformed meshes refit, moved instances placed again, the rest
     /// untouched. Returns false when the backend cannot (the default; the caller then builds a new

@@ -315,6 +315,64 @@ TEST(AccelBatch, MeshesWithInstancesCutOutsAndCulling) { check_batches(batch_mes
 
 TEST(AccelBatch, SpheresAndPlanesToo) { check_batches(batch_analytic_scene(), "analytic"); }
 
+/// Batch shadow queries (Accelerator::transmittance over a span) against the single-ray query of
+/// the same backend, on the analytic scene's rays in batches of 1..17 and all: the default loop
+/// (in-house backends, embree:packet=1) exactly; Embree's packets up to the order in which the
+/// factors of several transparent crossings are multiplied (relative 1e-6) and, as for closest
+/// hits, a crack at an edge on at most 1e-4 of the rays. MixedFilter's answers depend on the ray
+/// (the side a sphere or quadric is left by), so a lane handed another lane's ray or crossings
+/// would disagree.
+TEST(AccelBatch, ShadowBatchesEqualSingleQueries) {
+    const Scene s = batch_analytic_scene();
+    const CullingFilter filter(s);
+    for (const std::string& name : batch_backends()) {
+        SCOPED_TRACE(name);
+        const auto accel = create_accelerator(name, s, filter);
+        const bool loops = name.find("embree") == std::string::npos || name == "embree:packet=1";
+        const std::vector<Ray> rays = batch_rays(s, *accel, RayKind::Reflection);
+        std::vector<Color> single(rays.size());
+        size_t transparent = 0, blocked = 0;
+        for (size_t i = 0; i < rays.size(); ++i) {
+            single[i] = accel->transmittance(rays[i]);
+            transparent += !is_black(single[i]) && !(single[i] == Color(1.f));
+            blocked += is_black(single[i]);
+        }
+        EXPECT_GT(transparent, rays.size() / 20);  // the rays cross transparent surfaces
+        EXPECT_GT(blocked, rays.size() / 20);
+        size_t exact = 0, reordered = 0, differ = 0, total = 0;
+        std::vector<size_t> sizes;
+        for (size_t n = 1; n <= 17; ++n) sizes.push_back(n);
+        sizes.push_back(rays.size());
+        std::vector<Color> out(rays.size());
+        for (const size_t n : sizes) {
+            for (size_t b = 0; b < rays.size(); b += n) {
+                const size_t k = std::min(n, rays.size() - b);
+                accel->transmittance(std::span<const Ray>(rays.data() + b, k), std::span<Color>(out.data() + b, k));
+            }
+            for (size_t i = 0; i < rays.size(); ++i) {
+                ++total;
+                if (out[i] == single[i]) {
+                    ++exact;
+                    continue;
+                }
+                const Color d = out[i] - single[i];
+                const float m = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+                if (m <= 1e-6f * max_component(single[i])) ++reordered;
+                else ++differ;
+            }
+        }
+        std::printf("[ shadow ] %-16s %zu rays in batches of 1..17 and all: %zu identical, %zu reordered, %zu differ\n",
+                    name.c_str(), total, exact, reordered, differ);
+        if (loops) {
+            EXPECT_EQ(exact, total);
+        } else {
+            EXPECT_LE(double(differ), 1e-4 * double(total));
+        }
+        std::vector<Color> two(2);
+        EXPECT_THROW(accel->transmittance(std::span<const Ray>(rays.data(), 3), std::span<Color>(two)), Error);
+    }
+}
+
 /// Three coincident copies of one height field: mesh 0 in instances 0 and 1 (instanced), and
 /// mesh 1, its copy with every triangle listed twice (prim i and prim i + n coincide), alone in
 /// instance 2. Every hit on the surface is an exact tie between copies.

@@ -68,6 +68,7 @@ public:
         return h;
     }
     using Accelerator::intersect;
+    using Accelerator::transmittance;
     Color transmittance(const Ray& ray) const override {
         const Color s = m_inner.transmittance(ray);
         if (m_current >= 0) shadows[size_t(m_current)].push_back(s);

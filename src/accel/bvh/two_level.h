@@ -145,6 +145,7 @@ template <typename T, typename Blas, typename SphereBlas, typename Top = BinaryI
 class TwoLevelAccelerator final : public Accelerator {
 public:
     using Accelerator::intersect;  // the batch query: the default loop (no packet traversal here)
+    using Accelerator::transmittance;
     RayOffsetPolicy ray_offset() const override {
         return std::is_same_v<T, double> ? kDoubleRayOffset : kFloatRayOffset;
     }

@@ -40,6 +40,7 @@ inline bool intersect_plane(const Ray& ray, const Vec3d& point, const Vec3d& nor
 class PlaneDecorator final : public Accelerator {
 public:
     using Accelerator::intersect;
+    using Accelerator::transmittance;
     /// Takes ownership of `inner`, which was built for the same scene and filter.
     PlaneDecorator(std::unique_ptr<Accelerator> inner, const Scene& scene, const SurfaceFilter& filter)
         : m_inner(std::move(inner)), m_filter(filter) {
@@ -84,16 +85,26 @@ public:
 
     Color transmittance(const Ray& ray) const override {
         if (!ray_is_traceable(ray)) return Color(1.f);
-        Color tr(1.f);
-        for (const PlaneData& p : m_planes) {
-            float t;
-            if (!intersect_plane(ray, p.point, p.normal, t)) continue;
-            if (!(p.flags & SurfaceFilter::kNeedsTransmittance)) return Color(0.f);
-            tr *= m_filter.transmittance(ray, plane_hit(p, t));
-            if (is_black(tr)) return Color(0.f);
-        }
+        Color tr = plane_transmittance(ray);
+        if (is_black(tr)) return Color(0.f);
         tr *= m_inner->transmittance(ray);
         return is_black(tr) ? Color(0.f) : tr;
+    }
+
+    /// As transmittance() per ray, with the backend's batch query for what lies beyond the planes.
+    void transmittance(std::span<const Ray> rays, std::span<Color> out) const override {
+        RT_CHECK_EQ(rays.size(), out.size());
+        constexpr size_t kChunk = 64;
+        Color planes[kChunk];
+        for (size_t base = 0; base < rays.size(); base += kChunk) {
+            const size_t n = std::min(kChunk, rays.size() - base);
+            for (size_t i = 0; i < n; ++i) planes[i] = plane_transmittance(rays[base + i]);
+            m_inner->transmittance(rays.subspan(base, n), out.subspan(base, n));
+            for (size_t i = 0; i < n; ++i) {
+                const Color tr = is_black(planes[i]) ? Color(0.f) : planes[i] * out[base + i];
+                out[base + i] = is_black(tr) ? Color(0.f) : tr;
+            }
+        }
     }
 
     std::string name() const override { return m_inner->name(); }
@@ -121,6 +132,21 @@ private:
         }
         if (best.valid()) clipped.tfar = best.t;
         return best;
+    }
+
+    /// The product of the planes' transmittances along a shadow ray (exactly 0 once one blocks
+    /// it); 1 for an untraceable ray.
+    Color plane_transmittance(const Ray& ray) const {
+        Color tr(1.f);
+        if (!ray_is_traceable(ray)) return tr;
+        for (const PlaneData& p : m_planes) {
+            float t;
+            if (!intersect_plane(ray, p.point, p.normal, t)) continue;
+            if (!(p.flags & SurfaceFilter::kNeedsTransmittance)) return Color(0.f);
+            tr *= m_filter.transmittance(ray, plane_hit(p, t));
+            if (is_black(tr)) return Color(0.f);
+        }
+        return tr;
     }
 
     struct PlaneData {

@@ -74,6 +74,14 @@ struct SeenCrossing {
     uint8_t part;  ///< which root of a sphere (0 for triangles)
 };
 
+/// What one shadow ray's crossings so far let through, and the surfaces already counted (no
+/// initialiser on `seen`, so a query costs only what it uses).
+struct ShadowLane {
+    Color transmittance{1.f};
+    int seen_count = 0;
+    SeenCrossing seen[kMaxSeen];
+};
+
 /// The closest hit so far of one lane of a camera-ray query (tie rule; no default initialisers, so
 /// a QueryContext costs nothing more for the other queries).
 struct TieRecord {
@@ -96,9 +104,9 @@ struct QueryContext {
     /// (camera_tie_filter); set by context() for camera queries only (t = inf: none yet), left
     /// uninitialised for the others (no cost to shadow rays).
     TieRecord best[16];
-    Color transmittance{1.f};
-    int seen_count = 0;
-    SeenCrossing seen[kMaxSeen];
+    /// Shadow queries: per lane (RTCRay id), what the crossings so far let through; null for
+    /// closest-hit queries.
+    ShadowLane* shadow = nullptr;
 };
 
 Hit hit_from_filter_args(const RTCFilterFunctionNArguments* args, unsigned i, const QueryContext& q) {
@@ -156,17 +164,18 @@ void camera_tie_filter(const RTCFilterFunctionNArguments* args) {
 /// One candidate crossing of a shadow ray, in traversal order, with crossing_cosine() `cosine`:
 /// multiplies its transmittance unless the same surface was already counted (per (geom, inst,
 /// part) within the same_crossing() window). Returns true once nothing passes any more.
-bool add_crossing(QueryContext& q, const Hit& h, uint8_t part, float cosine) {
-    for (int k = 0; k < q.seen_count; ++k) {
-        const SeenCrossing& s = q.seen[k];
+bool add_crossing(const QueryContext& q, unsigned lane, const Hit& h, uint8_t part, float cosine) {
+    ShadowLane& l = q.shadow[lane];
+    for (int k = 0; k < l.seen_count; ++k) {
+        const SeenCrossing& s = l.seen[k];
         if (s.geom == h.geom && s.inst == h.inst && s.part == part && same_crossing(s.t, s.cosine, h.t, cosine))
             return false;
     }
-    const Color tr = q.filter->transmittance(q.rays[0], h);  // shadow queries are single rays
-    if (q.seen_count < kMaxSeen) q.seen[q.seen_count++] = {h.geom, h.inst, h.t, cosine, part};
-    q.transmittance *= tr;
-    if (!is_black(q.transmittance)) return false;
-    q.transmittance = Color(0.f);
+    const Color tr = q.filter->transmittance(q.rays[lane], h);
+    if (l.seen_count < kMaxSeen) l.seen[l.seen_count++] = {h.geom, h.inst, h.t, cosine, part};
+    l.transmittance *= tr;
+    if (!is_black(l.transmittance)) return false;
+    l.transmittance = Color(0.f);
     return true;
 }
 
@@ -183,7 +192,8 @@ void occluded_filter(const RTCFilterFunctionNArguments* args) {
         const Vec3f dir{RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
                         RTCRayN_dir_z(args->ray, args->N, i)};
         // Keep the hit (the ray is blocked, traversal stops) only once nothing passes.
-        if (!add_crossing(q, hit_from_filter_args(args, i, q), 0, crossing_cosine(ng, dir))) args->valid[i] = 0;
+        const unsigned lane = RTCRayN_id(args->ray, args->N, i);
+        if (!add_crossing(q, lane, hit_from_filter_args(args, i, q), 0, crossing_cosine(ng, dir))) args->valid[i] = 0;
     }
 }
 
@@ -293,7 +303,8 @@ void analytic_occluded(const RTCOccludedFunctionNArguments* args, const Analytic
         for (int part = 0; part < n; ++part) {
             const float t = roots[part];
             if (!(t > tnear && t <= tfar)) continue;
-            if (opaque || add_crossing(q, analytic_hit(s, t, face[part]), uint8_t(part), 1.f)) {
+            if (opaque || add_crossing(q, RTCRayN_id(args->ray, args->N, i), analytic_hit(s, t, face[part]),
+                                       uint8_t(part), 1.f)) {
                 tfar = -kInfinity;  // Embree's mark for an occluded ray
                 break;
             }
@@ -314,22 +325,29 @@ struct EmbreePacket;
 template <>
 struct EmbreePacket<4> {
     using RayHit = RTCRayHit4;
+    using Ray = RTCRay4;
     static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* rh) { rtcIntersect4(valid, s, c, rh); }
+    static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded4(valid, s, c, r); }
 };
 template <>
 struct EmbreePacket<8> {
     using RayHit = RTCRayHit8;
+    using Ray = RTCRay8;
     static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* rh) { rtcIntersect8(valid, s, c, rh); }
+    static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded8(valid, s, c, r); }
 };
 template <>
 struct EmbreePacket<16> {
     using RayHit = RTCRayHit16;
+    using Ray = RTCRay16;
     static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* rh) { rtcIntersect16(valid, s, c, rh); }
+    static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded16(valid, s, c, r); }
 };
 
 class EmbreeAccelerator final : public Accelerator {
 public:
     using Accelerator::intersect;
+    using Accelerator::transmittance;
 
     EmbreeAccelerator(const Scene& scene, const SurfaceFilter& filter, const EmbreeConfig& config)
         : m_scene(scene), m_filter(filter), m_packet_width(config.packet_width), m_compact(config.compact) {
@@ -498,11 +516,26 @@ public:
     Color transmittance(const Ray& ray) const override {
         if (!ray_is_traceable(ray)) return Color(1.f);
         QueryContext q = context(&ray, RayKind::Shadow);
+        ShadowLane lane;
+        q.shadow = &lane;
         RTCRay r;
         set_rtc_ray(r, ray);
         rtcOccluded1(m_top, &q.rtc, &r);
         if (r.tfar == -kInfinity) return Color(0.f);  // an opaque surface blocked it
-        return q.transmittance;
+        return lane.transmittance;
+    }
+
+    /// Packets of m_packet_width consecutive shadow rays (rtcOccluded4/8/16, coherent context),
+    /// each lane with its own crossings; a partial last packet and untraceable rays are
+    /// masked-off lanes (untraceable ones let everything through, as one by one).
+    void transmittance(std::span<const Ray> rays, std::span<Color> out) const override {
+        RT_CHECK_EQ(rays.size(), out.size());
+        switch (m_packet_width) {
+            case 4: return occluded_packets<4>(rays, out);
+            case 8: return occluded_packets<8>(rays, out);
+            case 16: return occluded_packets<16>(rays, out);
+            default: Accelerator::transmittance(rays, out);
+        }
     }
 
     std::string name() const override { return "embree"; }
@@ -568,6 +601,32 @@ private:
                 hits[base + i] = valid[i] ? to_hit(rh.hit.geomID[i], rh.hit.instID[0][i], rh.hit.primID[i],
                                                    rh.ray.tfar[i], rh.hit.u[i], rh.hit.v[i])
                                           : Hit{};
+        }
+    }
+
+    template <int K>
+    void occluded_packets(std::span<const Ray> rays, std::span<Color> out) const {
+        using Packet = typename EmbreePacket<K>::Ray;
+        for (size_t base = 0; base < rays.size(); base += K) {
+            const size_t n = std::min(rays.size() - base, size_t(K));
+            QueryContext q = context(rays.data() + base, RayKind::Shadow);
+            q.rtc.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+            ShadowLane lanes[K];
+            q.shadow = lanes;
+            alignas(64) int valid[K];
+            Packet r;
+            const Ray off{Vec3f(0.f), Vec3f(0.f, 0.f, 1.f), 0.f, 0.f};  // masked-off lanes
+            bool any = false;
+            for (int i = 0; i < K; ++i) {
+                const bool on = size_t(i) < n && ray_is_traceable(rays[base + size_t(i)]);
+                valid[i] = on ? -1 : 0;
+                any |= on;
+                set_rtc_lane(r, i, on ? rays[base + size_t(i)] : off);
+                r.id[i] = unsigned(i);  // the index in q.rays and q.shadow, for the callbacks
+            }
+            if (any) EmbreePacket<K>::occluded(valid, m_top, &q.rtc, &r);
+            for (size_t i = 0; i < n; ++i)
+                out[base + i] = !valid[i] ? Color(1.f) : r.tfar[i] == -kInfinity ? Color(0.f) : lanes[i].transmittance;
         }
     }
 
