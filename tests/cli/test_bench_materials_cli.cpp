@@ -33,7 +33,7 @@ TEST(BenchMaterialsCli, EveryExtensionHasARowAndChangesItsImage) {
     std::vector<std::string> header;
     const std::vector<Row> rows = read_csv(out / "materials.csv", &header);
     for (const char* column : {"extension", "sample", "kernel_with", "kernel_without", "seconds_with", "seconds_without",
-                               "ratio", "shadow_with", "shadow_without", "mean_abs_diff"})
+                               "ratio", "ratio_per_ray", "shadow_with", "shadow_without", "mean_abs_diff"})
         EXPECT_NE(std::find(header.begin(), header.end(), column), header.end()) << column;
     ASSERT_EQ(rows.size(), kExtensions.size());
     for (size_t i = 0; i < rows.size(); ++i) {
@@ -43,6 +43,10 @@ TEST(BenchMaterialsCli, EveryExtensionHasARowAndChangesItsImage) {
         const double ratio = num(row, "ratio");
         EXPECT_TRUE(std::isfinite(ratio)) << row.at("extension");
         EXPECT_GT(ratio, 0.0) << row.at("extension");
+        // One run: its pair's ratio; per ray: the same over the rays each side traced.
+        EXPECT_NEAR(ratio, num(row, "seconds_with") / num(row, "seconds_without"), 2e-2 * ratio) << row.at("extension");
+        const double per_ray = ratio * num(row, "total_without") / num(row, "total_with");
+        EXPECT_NEAR(num(row, "ratio_per_ray"), per_ray, 1e-3 * per_ray) << row.at("extension");
         EXPECT_GT(num(row, "materials_with"), 0.0) << row.at("extension");
         // The extension visibly changes its sample.
         EXPECT_GT(num(row, "mean_abs_diff"), 0.0) << row.at("extension");

@@ -121,8 +121,9 @@ TEST(EnvironmentOcclusion, ContactShadowHasTheAnalyticSize) {
                 const double fraction = 1.0 - std::pow(double(R) * R / D2, 1.5);
                 EXPECT_NEAR(film.beauty[film.index(px, kSize / 2)].x, open * arrives(fraction), tolerance)
                     << "at distance " << x;
-                if (kd > 0.f && fraction < 0.9)  // the neighbours' light is visible
+                if (kd > 0.f && fraction < 0.9) {  // the neighbours' light is visible
                     EXPECT_GT(film.beauty[film.index(px, kSize / 2)].x, open * fraction + 0.03) << "at distance " << x;
+                }
             }
         }
     }

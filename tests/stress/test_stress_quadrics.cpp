@@ -56,7 +56,9 @@ TEST(StressQuadrics, NoSelfHitsLeaksOrLostHitsAtAnyScale) {
                     EXPECT_LT(ne.max, 1e-5);
                     // Most inward rays are judged (those near a rim are not) where the shape spans
                     // at least a thousandth of its distance from the origin.
-                    if (s >= 1e-3 * t && kind != QuadricKind::Disc) EXPECT_LT(r.inward_unjudged, r.rays[1] / 2);
+                    if (s >= 1e-3 * t && kind != QuadricKind::Disc) {
+                        EXPECT_LT(r.inward_unjudged, r.rays[1] / 2);
+                    }
                 }
 }
 
