@@ -971,6 +971,15 @@ private:
                      m.iridescence_thickness_max);
             m.iridescence_thickness_texture = texture_ref_value(find_member(e, "iridescenceThicknessTexture"), false,
                                                                 p + "/iridescenceThicknessTexture");
+            // Valid glTF, and rendered as the extension's mix says, but most likely a slip: said once.
+            if (m.iridescence_thickness_min > m.iridescence_thickness_max)
+                m_warnings.add("iridescence-range:" + p,
+                               fmt::format("{}/iridescenceThicknessMinimum: {} nm above iridescenceThicknessMaximum {} "
+                                           "nm, kept as given ({})",
+                                           p, m.iridescence_thickness_min, m.iridescence_thickness_max,
+                                           m.iridescence_thickness_texture.valid()
+                                               ? "the film thins where the thickness texture's green rises"
+                                               : "unused: without iridescenceThicknessTexture the thickness is the maximum"));
         }
         if (const tinygltf::Value* e = find_extension(extensions, "KHR_materials_anisotropy")) {
             const std::string p = eptr + "KHR_materials_anisotropy";
