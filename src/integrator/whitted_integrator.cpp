@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "core/error.h"
-#include "core/radix_sort.h"
+#include "core/tail_split.h"
 #include "core/uninitialized.h"
 #include "integrator/contacts.h"
 #include "shading/local_model.h"
@@ -41,10 +41,11 @@ PrimaryInfo first_hit(const Hit& hit, const Vec3f& N, const WhittedCoeffs& c) {
 /// Ward's adaptive test ("Adaptive Shadow Testing for Ray Tracing", 1991) over n candidates:
 /// potential(j) is what candidate j gives if nothing blocks it (a Color, not negative), test(j) what
 /// arrives through the scene. Candidates are tested from the largest potential down (ties in index
-/// order, so the result does not depend on the sort) until what the untested ones could still add,
-/// times the path weight `weight`, is below `min_weight`; the untested then add their potential
-/// scaled by the fraction the tested ones let through (per channel), or unscaled when none was
-/// tested. Adds everything to `sum` and the untested count to `skipped`; min_weight 0 tests all.
+/// order) until what the untested ones could still add, times the path weight `weight`, is below
+/// `min_weight`; the untested then add their potential scaled by the fraction the tested ones let
+/// through (per channel), or unscaled when none was tested. Adds everything to `sum` and the
+/// untested count to `skipped`; min_weight 0 tests all. Which candidates are tested is found by
+/// selection (split_tail), not by sorting them all; the sums run in the order it leaves them in.
 template <typename Potential, typename Test>
 Color adaptive_test(Color sum, size_t n, Potential potential, Test test, float weight, float min_weight,
                     uint64_t& skipped) {
@@ -57,24 +58,20 @@ Color adaptive_test(Color sum, size_t n, Potential potential, Test test, float w
         const float key = m > 0.f ? m : 0.f;  // -0 and NaN as 0
         order[j] = uint64_t(~std::bit_cast<uint32_t>(key)) << 32 | uint64_t(j);
     }
-    thread_local std::vector<uint64_t> scratch;
-    sort_by_high_word(order, scratch);  // = std::sort(order): the indices ascend in the input
-    auto nth = [&](size_t k) -> const Color& { return potential(uint32_t(order[k])); };
-    Color untested(0.f);
-    for (size_t k = 0; k < n; ++k) untested += nth(k);
+    auto candidate = [&](uint64_t key) -> const Color& { return potential(uint32_t(key)); };
+    const size_t i = split_tail(
+        std::span<uint64_t>(order), candidate,
+        [&](const Color& untested) { return !(weight * max_component(untested) >= min_weight); });
     Color tested(0.f), passed(0.f);
-    size_t i = 0;
-    for (; i < n && weight * max_component(untested) >= min_weight; ++i) {
-        passed += test(uint32_t(order[i]));
-        tested += nth(i);
-        untested = untested - nth(i);
-        untested = Color(std::max(untested.x, 0.f), std::max(untested.y, 0.f), std::max(untested.z, 0.f));
+    for (size_t k = 0; k < i; ++k) {
+        passed += test(uint32_t(order[k]));
+        tested += candidate(order[k]);
     }
     sum += passed;
     if (i == n) return sum;
     skipped += n - i;
-    untested = Color(0.f);  // summed again: the running difference above is not exact
-    for (size_t j = i; j < n; ++j) untested += nth(j);
+    Color untested(0.f);
+    for (size_t j = i; j < n; ++j) untested += candidate(order[j]);
     if (i == 0) return sum + untested;  // all of them together below min_weight: unblocked
     const Color let_through(tested.x > 0.f ? passed.x / tested.x : 1.f, tested.y > 0.f ? passed.y / tested.y : 1.f,
                             tested.z > 0.f ? passed.z / tested.z : 1.f);
