@@ -575,6 +575,23 @@ private:
         return h;
     }
 
+    /// Lanes of a packet from up to K rays: each lane's ray id is its index (q.rays, q.shadow);
+    /// lanes past the rays and untraceable rays are masked off (valid 0) but still hold a finite
+    /// ray, since Embree loads whole packets. Returns whether any lane is on.
+    template <int K, class RTCRayK>
+    static bool fill_lanes(RTCRayK& r, int* valid, std::span<const Ray> rays) {
+        const Ray off{Vec3f(0.f), Vec3f(0.f, 0.f, 1.f), 0.f, 0.f};
+        bool any = false;
+        for (int i = 0; i < K; ++i) {
+            const bool on = size_t(i) < rays.size() && ray_is_traceable(rays[size_t(i)]);
+            valid[i] = on ? -1 : 0;
+            any |= on;
+            set_rtc_lane(r, i, on ? rays[size_t(i)] : off);
+            r.id[i] = unsigned(i);
+        }
+        return any;
+    }
+
     template <int K>
     void intersect_packets(std::span<const Ray> rays, RayKind kind, std::span<Hit> hits) const {
         using Packet = typename EmbreePacket<K>::RayHit;
@@ -584,15 +601,8 @@ private:
             q.rtc.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
             alignas(64) int valid[K];
             Packet rh;
-            const Ray off{Vec3f(0.f), Vec3f(0.f, 0.f, 1.f), 0.f, 0.f};  // masked-off lanes
-            bool any = false;
+            const bool any = fill_lanes<K>(rh.ray, valid, rays.subspan(base, n));
             for (int i = 0; i < K; ++i) {
-                // Masked-off lanes still get a finite ray: Embree loads whole packets.
-                const bool on = size_t(i) < n && ray_is_traceable(rays[base + size_t(i)]);
-                valid[i] = on ? -1 : 0;
-                any |= on;
-                set_rtc_lane(rh.ray, i, on ? rays[base + size_t(i)] : off);
-                rh.ray.id[i] = unsigned(i);  // the index in q.rays, for the callbacks
                 rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                 rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
             }
@@ -615,15 +625,7 @@ private:
             q.shadow = lanes;
             alignas(64) int valid[K];
             Packet r;
-            const Ray off{Vec3f(0.f), Vec3f(0.f, 0.f, 1.f), 0.f, 0.f};  // masked-off lanes
-            bool any = false;
-            for (int i = 0; i < K; ++i) {
-                const bool on = size_t(i) < n && ray_is_traceable(rays[base + size_t(i)]);
-                valid[i] = on ? -1 : 0;
-                any |= on;
-                set_rtc_lane(r, i, on ? rays[base + size_t(i)] : off);
-                r.id[i] = unsigned(i);  // the index in q.rays and q.shadow, for the callbacks
-            }
+            const bool any = fill_lanes<K>(r, valid, rays.subspan(base, n));
             if (any) EmbreePacket<K>::occluded(valid, m_top, &q.rtc, &r);
             for (size_t i = 0; i < n; ++i)
                 out[base + i] = !valid[i] ? Color(1.f) : r.tfar[i] == -kInfinity ? Color(0.f) : lanes[i].transmittance;
