@@ -120,10 +120,9 @@ Color layered_term(const WhittedCoeffs& c, const LayerCoeffs& l, const Vec3f& N,
 
     // The base: its diffuse and highlight terms, scaled by the sheen's albedo at L over the one at V.
     Color base = c.kd * n_dot_l;
-    if (!is_black(c.ks)) {
-        const float scale = environment_light ? l.environment_scale : 1.f;
+    const float scale = environment_light ? l.environment_scale : 1.f;
+    if (!is_black(c.ks) && scale > 0.f)  // scale 0: the prefiltered map carries this lobe (local_model.h)
         base += c.ks * ((l.anisotropic ? anisotropic_lobe(l, N, H) : lobe(n_dot_h, c.n)) * scale);
-    }
     Color term = base;
     if (!is_black(l.sheen)) {
         const SheenAtLight sheen = sheen_at_light(l.sheen_lobe, n_dot_h, n_dot_l);
@@ -133,10 +132,9 @@ Color layered_term(const WhittedCoeffs& c, const LayerCoeffs& l, const Vec3f& N,
     }
 
     // The coat's highlight about its own normal.
-    if (l.coat > 0.f && dot(l.Nc, L) > 0.f) {
-        const float scale = environment_light ? l.coat_environment_scale : 1.f;
-        term += Color(l.coat * lobe(std::max(0.f, dot(l.Nc, H)), l.coat_n) * scale);
-    }
+    const float coat_scale = environment_light ? l.coat_environment_scale : 1.f;
+    if (l.coat > 0.f && coat_scale > 0.f && dot(l.Nc, L) > 0.f)
+        term += Color(l.coat * lobe(std::max(0.f, dot(l.Nc, H)), l.coat_n) * coat_scale);
     return term;
 }
 

@@ -46,11 +46,12 @@ inline float highlight_lobe(float n_dot_h, float n) {
 }
 
 /// kd (N.L) + ks (N.H)^n for unit N, L (toward the light) and V (toward the viewer), n_dot_l = N.L > 0.
-/// highlight_scale: 1 but for the lights extracted from an environment (environment_highlight_scale).
+/// highlight_scale: 1 but for the lights extracted from an environment (environment_highlight_scale);
+/// at 0 (a lobe rougher than n = 4, which the prefiltered map carries) the highlight is not evaluated.
 inline Color local_term(const WhittedCoeffs& c, const Vec3f& N, const Vec3f& L, const Vec3f& V, float n_dot_l,
                         float highlight_scale = 1.f) {
     Color term = c.kd * n_dot_l;
-    if (!is_black(c.ks)) {
+    if (!is_black(c.ks) && highlight_scale > 0.f) {
         const Vec3f H = normalize(L + V);
         const float n_dot_h = std::max(0.f, dot(N, H));
         if (const float lobe = highlight_lobe(n_dot_h, c.n); lobe > 0.f) term += c.ks * (lobe * highlight_scale);
