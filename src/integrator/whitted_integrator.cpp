@@ -40,12 +40,13 @@ PrimaryInfo first_hit(const Hit& hit, const Vec3f& N, const WhittedCoeffs& c) {
 
 /// Ward's adaptive test ("Adaptive Shadow Testing for Ray Tracing", 1991) over n candidates:
 /// potential(j) is what candidate j gives if nothing blocks it (a Color, not negative), test(j) what
-/// arrives through the scene. Candidates are tested from the largest potential down (ties in index
-/// order) until what the untested ones could still add, times the path weight `weight`, is below
+/// arrives through the scene. The candidates of largest potential (ties by index) are tested, as
+/// few as leave what the untested ones could still add, times the path weight `weight`, below
 /// `min_weight`; the untested then add their potential scaled by the fraction the tested ones let
 /// through (per channel), or unscaled when none was tested. Adds everything to `sum` and the
 /// untested count to `skipped`; min_weight 0 tests all. Which candidates are tested is found by
-/// selection (split_tail), not by sorting them all; the sums run in the order it leaves them in.
+/// selection (split_tail), not by sorting them all; the tests and sums run in the order it leaves
+/// them in.
 template <typename Potential, typename Test>
 Color adaptive_test(Color sum, size_t n, Potential potential, Test test, float weight, float min_weight,
                     uint64_t& skipped) {
