@@ -94,8 +94,12 @@ public:
     /// sample_light(scene().lights[light], p); a directional light's sample, the same at every
     /// point, comes from a table made once.
     LightSample sample_light(uint32_t light, const Vec3f& p) const {
-        const Light& l = m_scene.lights[light];
-        return l.type == LightType::Directional ? m_directional_samples[light] : whitted::sample_light(l, p);
+        const LightSample* cached = directional_sample(light);
+        return cached ? *cached : whitted::sample_light(m_scene.lights[light], p);
+    }
+    /// A directional light's sample from that table (the same at every point), else null.
+    const LightSample* directional_sample(uint32_t light) const {
+        return m_scene.lights[light].type == LightType::Directional ? &m_directional_samples[light] : nullptr;
     }
 
     // SurfaceFilter

@@ -315,7 +315,7 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
     std::optional<Vec3f> back_org;    // diffuse transmission: lights behind the surface
     struct Candidate {
         const Light* light;
-        LightSample ls;
+        const LightSample* ls;  // the sample (an environment's lights: SceneView's table, no copy)
         Color potential;  // Is fat (kd N.L + ks (N.H)^n): the light's term if nothing shadows it
         bool behind;      // seen through the surface (diffuse transmission)
     };
@@ -324,7 +324,7 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
     auto shadowed = [&](const Candidate& e) {
         if (!shadow_org) shadow_org = m_offset.origin(s.f.front ? s.sp.p_shadow : s.sp.p, s.sp.offset_scale, s.f.Ng);
         if (e.behind && !back_org) back_org = m_offset.origin(s.sp.p, s.sp.offset_scale, -s.f.Ng);
-        const Color shadow = shadow_factor(*e.light, e.ls, e.behind ? *back_org : *shadow_org, counters);
+        const Color shadow = shadow_factor(*e.light, *e.ls, e.behind ? *back_org : *shadow_org, counters);
         if (is_black(shadow)) return Color(0.f);
         // Opaque scenes: the shadow factor is exactly 1 here, and x * 1 == x.
         if constexpr (K.transmission) return e.potential * shadow;
@@ -335,7 +335,12 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
     const float environment_scale = m_view.environment() ? environment_highlight_scale(c.n) : 1.f;
     auto add_light = [&](uint32_t index) {
         const Light& light = m_view.scene().lights[index];
-        const LightSample ls = m_view.sample_light(index, s.sp.p);
+        // Directional lights (every light extracted from an environment) read their sample in
+        // place; the others compute it here.
+        const LightSample* cached = m_view.directional_sample(index);
+        LightSample computed;
+        if (!cached) computed = m_view.sample_light(index, s.sp.p);
+        const LightSample& ls = cached ? *cached : computed;
         if (is_black(ls.intensity)) {  // beyond its range window or outside its spot cone
             ++counters.shadow_skipped_unreached;
             return;
@@ -360,11 +365,14 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
             ++counters.shadow_skipped_zero;
             return;
         }
-        const Candidate e{&light, ls, ls.intensity * term, behind};
-        if (!light.from_environment) {
+        const Candidate e{&light, &ls, ls.intensity * term, behind};
+        if (!light.from_environment || !cached) {  // (an environment's lights are all directional)
             sum += shadowed(e);
             return;
         }
+        // e.ls points into SceneView's table, which outlives the adaptive test below (copying
+        // the sample in stalled on reading back its own partial stores: a tenth of this loop's
+        // samples).
         environment.push_back(e);
     };
     if constexpr (K.tables) {
