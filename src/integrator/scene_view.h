@@ -91,13 +91,8 @@ public:
         return m_analysis.lights_of(object_index(m_scene, hit.geom, hit.inst));
     }
 
-    /// sample_light(scene().lights[light], p); a directional light's sample, the same at every
-    /// point, comes from a table made once.
-    LightSample sample_light(uint32_t light, const Vec3f& p) const {
-        const LightSample* cached = directional_sample(light);
-        return cached ? *cached : whitted::sample_light(m_scene.lights[light], p);
-    }
-    /// A directional light's sample from that table (the same at every point), else null.
+    /// sample_light(scene().lights[light], p) of a directional light, the same at every point,
+    /// from a table made once; null for the other kinds (the caller samples them at its point).
     const LightSample* directional_sample(uint32_t light) const {
         return m_scene.lights[light].type == LightType::Directional ? &m_directional_samples[light] : nullptr;
     }

@@ -339,7 +339,7 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         // place; the others compute it here.
         const LightSample* cached = m_view.directional_sample(index);
         LightSample computed;
-        if (!cached) computed = m_view.sample_light(index, s.sp.p);
+        if (!cached) computed = sample_light(light, s.sp.p);
         const LightSample& ls = cached ? *cached : computed;
         if (is_black(ls.intensity)) {  // beyond its range window or outside its spot cone
             ++counters.shadow_skipped_unreached;
