@@ -39,12 +39,14 @@ PrimaryInfo first_hit(const Hit& hit, const Vec3f& N, const WhittedCoeffs& c) {
 }
 
 /// Ward's adaptive test ("Adaptive Shadow Testing for Ray Tracing", 1991) over n candidates:
-/// potential(j) is what candidate j gives if nothing blocks it (a Color, not negative), test(j) what
-/// arrives through the scene. The candidates of largest potential (ties by index) are tested, as
-/// few as leave what the untested ones could still add, times the path weight `weight`, below
-/// `min_weight`; the untested then add their potential scaled by the fraction the tested ones let
-/// through (per channel), or unscaled when none was tested. Adds everything to `sum` and the
-/// untested count to `skipped`; min_weight 0 tests all. Which candidates are tested is found by
+/// potential(j) is what candidate j gives if nothing blocks it (a Color, not negative);
+/// test(ids, out) sets out[k] to what arrives through the scene from candidate ids[k]. The
+/// candidates of largest potential (ties by index) are tested, as few as leave what the untested
+/// ones could still add, times the path weight `weight`, below `min_weight`; the untested then add
+/// their potential scaled by the fraction the tested ones let through (per channel), or unscaled
+/// when none was tested. Adds everything to `sum` and the untested count to `skipped`; min_weight
+/// 0 tests all. Which candidates are tested depends on the potentials alone, so they are tested
+/// together, in one call (one batch query of the accelerator). Which they are is found by
 /// selection (split_tail), not by sorting them all; the tests and sums run in the order it leaves
 /// them in.
 template <typename Potential, typename Test>
@@ -63,9 +65,15 @@ Color adaptive_test(Color sum, size_t n, Potential potential, Test test, float w
     const size_t i = split_tail(
         std::span<uint64_t>(order), candidate,
         [&](const Color& untested) { return !(weight * max_component(untested) >= min_weight); });
+    thread_local std::vector<uint32_t> ids;
+    thread_local std::vector<Color> through;
+    ids.resize(i);
+    through.resize(i);
+    for (size_t k = 0; k < i; ++k) ids[k] = uint32_t(order[k]);
+    test(std::span<const uint32_t>(ids), std::span<Color>(through));
     Color tested(0.f), passed(0.f);
     for (size_t k = 0; k < i; ++k) {
-        passed += test(uint32_t(order[k]));
+        passed += through[k];
         tested += candidate(order[k]);
     }
     sum += passed;
@@ -215,14 +223,34 @@ Color WhittedIntegrator::environment_visibility(const Shading& s, float stake, R
     cells.assign(grid.size(), Cell{});
     const SmoothFrame frame(s.f.N);
     const Vec3f org = m_offset.origin(s.f.front ? s.sp.p_shadow : s.sp.p, s.sp.offset_scale, s.f.Ng);
-    auto transmittance = [&](const Vec3f& local) {
+    // The occlusion ray toward a direction of the frame, or none below the geometric surface.
+    auto occlusion_ray = [&](const Vec3f& local) -> std::optional<Ray> {
         Ray r;
         r.org = org;
         r.dir = frame.to_world(local);
         r.tfar = kInfinity;
-        if (!(dot(r.dir, s.f.Ng) > 0.f)) return Color(1.f);
-        ++counters.occlusion;
-        return m_accel.transmittance(r);
+        if (!(dot(r.dir, s.f.Ng) > 0.f)) return std::nullopt;
+        return r;
+    };
+    // Transmittances along the directions local(0..m), one batch query.
+    thread_local std::vector<Ray> batch;
+    thread_local std::vector<Color> batch_through;
+    thread_local std::vector<uint32_t> batch_slot;
+    auto transmittance_along = [&](size_t m, auto local, auto put) {
+        batch.clear();
+        batch_slot.clear();
+        for (size_t k = 0; k < m; ++k) {
+            if (const std::optional<Ray> r = occlusion_ray(local(k))) {
+                batch.push_back(*r);
+                batch_slot.push_back(uint32_t(k));
+            } else {
+                put(k, Color(1.f));
+            }
+        }
+        counters.occlusion += batch.size();
+        batch_through.resize(batch.size());
+        transmittances(std::span<const Ray>(batch), std::span<Color>(batch_through));
+        for (size_t b = 0; b < batch.size(); ++b) put(batch_slot[b], batch_through[b]);
     };
     Color total(0.f);
     for (size_t k = 0; k < cells.size(); ++k) {
@@ -234,10 +262,14 @@ Color WhittedIntegrator::environment_visibility(const Shading& s, float stake, R
     }
     if (is_black(total)) return Color(1.f);
     bool blocked = false;
-    auto test = [&](size_t k) {
-        cells[k].through = transmittance(grid.centres[k]);
-        if (!(cells[k].through == Color(1.f))) blocked = true;
-        return Color(0.f);  // summed below, after the refinement
+    auto test = [&](std::span<const uint32_t> ids, std::span<Color> out) {
+        transmittance_along(
+            ids.size(), [&](size_t k) { return grid.centres[ids[k]]; },
+            [&](size_t k, const Color& t) {
+                cells[ids[k]].through = t;
+                if (!(t == Color(1.f))) blocked = true;
+            });
+        std::fill(out.begin(), out.end(), Color(0.f));  // summed below, after the refinement
     };
     // The weight that turns a cell's radiance into its share of the stake.
     const float scale = worth / max_component(total);
@@ -256,8 +288,9 @@ Color WhittedIntegrator::environment_visibility(const Shading& s, float stake, R
     auto refine = [&](auto& self, float u0, float v0, float size, int level, float share) -> Color {
         const float h = 0.5f * size;
         std::array<Color, 4> t;
-        for (int c = 0; c < 4; ++c)
-            t[c] = transmittance(cosine_direction(u0 + h * (float(c % 2) + 0.5f), v0 + h * (float(c / 2) + 0.5f)));
+        transmittance_along(
+            4, [&](size_t c) { return cosine_direction(u0 + h * (float(c % 2) + 0.5f), v0 + h * (float(c / 2) + 0.5f)); },
+            [&](size_t c, const Color& x) { t[c] = x; });
         if (level + 1 < kOcclusionLevels && 0.25f * share >= m_settings.min_weight) {
             std::array<bool, 4> edge;
             for (int c = 0; c < 4; ++c) edge[c] = differs(t[c], t[c ^ 1]) || differs(t[c], t[c ^ 2]);
@@ -321,14 +354,42 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
     };
     thread_local std::vector<Candidate> environment;
     environment.clear();
-    auto shadowed = [&](const Candidate& e) {
+    auto origin = [&](const Candidate& e) -> const Vec3f& {
         if (!shadow_org) shadow_org = m_offset.origin(s.f.front ? s.sp.p_shadow : s.sp.p, s.sp.offset_scale, s.f.Ng);
         if (e.behind && !back_org) back_org = m_offset.origin(s.sp.p, s.sp.offset_scale, -s.f.Ng);
-        const Color shadow = shadow_factor(*e.light, *e.ls, e.behind ? *back_org : *shadow_org, counters);
+        return e.behind ? *back_org : *shadow_org;
+    };
+    auto lit = [&](const Candidate& e, const Color& shadow) {
         if (is_black(shadow)) return Color(0.f);
         // Opaque scenes: the shadow factor is exactly 1 here, and x * 1 == x.
         if constexpr (K.transmission) return e.potential * shadow;
         else return e.potential;
+    };
+    auto shadowed = [&](const Candidate& e) {
+        const std::optional<Ray> ray = shadow_ray(*e.light, *e.ls, origin(e));
+        if (!ray) return Color(0.f);
+        count(counters, RayKind::Shadow);
+        return lit(e, m_accel.transmittance(*ray));
+    };
+    // The tested extracted lights' shadow rays, one batch query (they are known before any is traced).
+    thread_local std::vector<Ray> batch;
+    thread_local std::vector<Color> batch_shadow;
+    thread_local std::vector<uint32_t> batch_slot;
+    auto shadowed_all = [&](std::span<const uint32_t> ids, std::span<Color> out) {
+        batch.clear();
+        batch_slot.clear();
+        for (size_t k = 0; k < ids.size(); ++k) {
+            out[k] = Color(0.f);
+            const Candidate& e = environment[ids[k]];
+            if (const std::optional<Ray> ray = shadow_ray(*e.light, *e.ls, origin(e))) {
+                batch.push_back(*ray);
+                batch_slot.push_back(uint32_t(k));
+            }
+        }
+        counters.shadow += batch.size();
+        batch_shadow.resize(batch.size());
+        transmittances(std::span<const Ray>(batch), std::span<Color>(batch_shadow));
+        for (size_t b = 0; b < batch.size(); ++b) out[batch_slot[b]] = lit(environment[ids[batch_slot[b]]], batch_shadow[b]);
     };
     // The extracted lights' highlight scale depends on the material alone: once per point where
     // there are such lights (an environment), instead of once per light.
@@ -387,11 +448,10 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
 
     return adaptive_test(
         sum, environment.size(), [&](size_t j) -> const Color& { return environment[j].potential; },
-        [&](size_t j) { return shadowed(environment[j]); }, s.weight, m_settings.min_weight, counters.shadow_skipped_dim);
+        shadowed_all, s.weight, m_settings.min_weight, counters.shadow_skipped_dim);
 }
 
-Color WhittedIntegrator::shadow_factor(const Light& light, const LightSample& ls, const Vec3f& org,
-                                       RayCounters& counters) const {
+std::optional<Ray> WhittedIntegrator::shadow_ray(const Light& light, const LightSample& ls, const Vec3f& org) {
     Ray shadow;
     shadow.org = org;
     if (light.type == LightType::Directional) {
@@ -400,15 +460,19 @@ Color WhittedIntegrator::shadow_factor(const Light& light, const LightSample& ls
     } else {
         const Vec3f to_light = Vec3f(light.position) - org;
         const float d = length(to_light);
-        if (!(d > 0.f)) return Color(0.f);
+        if (!(d > 0.f)) return std::nullopt;
         shadow.dir = to_light / d;
         shadow.tfar = d * (1.f - 1e-5f);
     }
-    count(counters, RayKind::Shadow);
-    return m_accel.transmittance(shadow);
+    return shadow;
 }
 
 // ---- Recursive rays: kt T and kr R --------------------------------------------------------------
+
+void WhittedIntegrator::transmittances(std::span<const Ray> rays, std::span<Color> out) const {
+    if (!m_kernel.transmission) return m_accel.transmittance(rays, out);
+    for (size_t i = 0; i < rays.size(); ++i) out[i] = m_accel.transmittance(rays[i]);
+}
 
 bool WhittedIntegrator::worth_tracing(float w, RayCounters& counters) const {
     // Hall & Greenberg (1983): a branch whose path weight is below min_weight cannot change the

@@ -274,8 +274,8 @@ BatchResult compare_batches(const Accelerator& accel, const std::vector<Ray>& ra
 }
 
 std::vector<std::string> batch_backends() {
-    std::vector<std::string> names = accelerator_names();  // "embree" traces 16-wide packets
-    for (const char* n : {"embree:packet=1", "embree:packet=4", "embree:packet=8", "embree:compact=1"}) names.push_back(n);
+    std::vector<std::string> names = accelerator_names();  // "embree": 4-wide packets
+    for (const char* n : {"embree:packet=1", "embree:packet=4", "embree:packet=8", "embree:packet=16", "embree:compact=1"}) names.push_back(n);
     return names;
 }
 
@@ -317,7 +317,8 @@ TEST(AccelBatch, SpheresAndPlanesToo) { check_batches(batch_analytic_scene(), "a
 
 /// Batch shadow queries (Accelerator::transmittance over a span) against the single-ray query of
 /// the same backend, on the analytic scene's rays in batches of 1..17 and all: the default loop
-/// (in-house backends, embree:packet=1) exactly; Embree's packets up to the order in which the
+/// (in-house backends, embree:shadow_packet=1) exactly; Embree's packets (its shadow batches are
+/// `shadow_packet` wide, 16 by default, 1, 4 and 8 here too) up to the order in which the
 /// factors of several transparent crossings are multiplied (relative 1e-6) and, as for closest
 /// hits, a crack at an edge on at most 1e-4 of the rays. MixedFilter's answers depend on the ray
 /// (the side a sphere or quadric is left by), so a lane handed another lane's ray or crossings
@@ -325,10 +326,14 @@ TEST(AccelBatch, SpheresAndPlanesToo) { check_batches(batch_analytic_scene(), "a
 TEST(AccelBatch, ShadowBatchesEqualSingleQueries) {
     const Scene s = batch_analytic_scene();
     const CullingFilter filter(s);
-    for (const std::string& name : batch_backends()) {
+    std::vector<std::string> names = accelerator_names();  // "embree": 16-wide shadow packets
+    for (const char* n : {"embree:shadow_packet=1", "embree:shadow_packet=4", "embree:shadow_packet=8",
+                          "embree:compact=1"})
+        names.push_back(n);
+    for (const std::string& name : names) {
         SCOPED_TRACE(name);
         const auto accel = create_accelerator(name, s, filter);
-        const bool loops = name.find("embree") == std::string::npos || name == "embree:packet=1";
+        const bool loops = name.find("embree") == std::string::npos || name == "embree:shadow_packet=1";
         const std::vector<Ray> rays = batch_rays(s, *accel, RayKind::Reflection);
         std::vector<Color> single(rays.size());
         size_t transparent = 0, blocked = 0;
@@ -538,6 +543,7 @@ TEST(AccelBatch, EmptyBatchAndSizeMismatch) {
         EXPECT_THROW(accel->intersect(std::span<const Ray>(rays), RayKind::Camera, std::span<Hit>(hits)), Error);
     }
     EXPECT_THROW((void)create_accelerator("embree:packet=2", s, filter), Error);
+    EXPECT_THROW((void)create_accelerator("embree:shadow_packet=3", s, filter), Error);
 }
 
 // ---- transparent crossings at a shared edge seen at grazing incidence ----

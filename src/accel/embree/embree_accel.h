@@ -14,6 +14,7 @@ struct EmbreeConfig {
     bool robust = false;   ///< RTC_SCENE_FLAG_ROBUST: slower traversal that avoids some edge misses
     int threads = 0;       ///< build threads, 0 = all
     int packet_width = 4;  ///< batch closest-hit queries: rays per rtcIntersect4/8/16 packet, 1 = rtcIntersect1 each
+    int shadow_packet_width = 16;  ///< batch shadow queries: rays per rtcOccluded4/8/16 packet, 1 = rtcOccluded1 each
     bool compact = false;  ///< RTC_SCENE_FLAG_COMPACT: leaves index the vertices instead of copying them
                            ///< (less memory, slower camera rays; docs/performance.md)
     /// A mesh that one instance alone uses (with a transform that keeps orientation) goes into the

@@ -100,10 +100,14 @@ std::unique_ptr<Accelerator> create_backend(const std::string& name, const Scene
     AccelSpec spec(name);
     if (spec.name() == "embree") {
         EmbreeConfig c{config.robust, config.threads};
-        if (const std::string* p = spec.find("packet")) {
-            if (*p == "1" || *p == "4" || *p == "8" || *p == "16") c.packet_width = std::stoi(*p);
-            else throw Error(fmt::format("accelerator '{}': packet must be 1, 4, 8 or 16", name));
-        }
+        auto width = [&](const char* key, int& value) {
+            if (const std::string* p = spec.find(key)) {
+                if (*p == "1" || *p == "4" || *p == "8" || *p == "16") value = std::stoi(*p);
+                else throw Error(fmt::format("accelerator '{}': {} must be 1, 4, 8 or 16", name, key));
+            }
+        };
+        width("packet", c.packet_width);
+        width("shadow_packet", c.shadow_packet_width);
         if (const std::string* k = spec.find("compact")) {
             if (*k == "0" || *k == "1") c.compact = *k == "1";
             else throw Error(fmt::format("accelerator '{}': compact must be 0 or 1", name));
@@ -112,7 +116,7 @@ std::unique_ptr<Accelerator> create_backend(const std::string& name, const Scene
             if (*f == "0" || *f == "1") c.flatten = *f == "1";
             else throw Error(fmt::format("accelerator '{}': flatten must be 0 or 1", name));
         }
-        spec.check_all_used("packet, compact, flatten");
+        spec.check_all_used("packet, shadow_packet, compact, flatten");
         return create_embree_accelerator(scene, filter, c);
     }
     if (spec.name() == "bvh") {
