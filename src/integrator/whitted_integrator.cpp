@@ -249,7 +249,7 @@ Color WhittedIntegrator::environment_visibility(const Shading& s, float stake, R
         }
         counters.occlusion += batch.size();
         batch_through.resize(batch.size());
-        transmittances(std::span<const Ray>(batch), std::span<Color>(batch_through));
+        m_accel.transmittance(std::span<const Ray>(batch), std::span<Color>(batch_through));
         for (size_t b = 0; b < batch.size(); ++b) put(batch_slot[b], batch_through[b]);
     };
     Color total(0.f);
@@ -388,7 +388,7 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         }
         counters.shadow += batch.size();
         batch_shadow.resize(batch.size());
-        transmittances(std::span<const Ray>(batch), std::span<Color>(batch_shadow));
+        m_accel.transmittance(std::span<const Ray>(batch), std::span<Color>(batch_shadow));
         for (size_t b = 0; b < batch.size(); ++b) out[batch_slot[b]] = lit(environment[ids[batch_slot[b]]], batch_shadow[b]);
     };
     // The extracted lights' highlight scale depends on the material alone: once per point where
@@ -468,11 +468,6 @@ std::optional<Ray> WhittedIntegrator::shadow_ray(const Light& light, const Light
 }
 
 // ---- Recursive rays: kt T and kr R --------------------------------------------------------------
-
-void WhittedIntegrator::transmittances(std::span<const Ray> rays, std::span<Color> out) const {
-    if (!m_kernel.transmission) return m_accel.transmittance(rays, out);
-    for (size_t i = 0; i < rays.size(); ++i) out[i] = m_accel.transmittance(rays[i]);
-}
 
 bool WhittedIntegrator::worth_tracing(float w, RayCounters& counters) const {
     // Hall & Greenberg (1983): a branch whose path weight is below min_weight cannot change the

@@ -174,10 +174,6 @@ private:
     /// The shadow ray from `org` toward the light (s_i is the accelerator's transmittance along
     /// it); none when the point is at the light itself.
     static std::optional<Ray> shadow_ray(const Light& light, const LightSample& ls, const Vec3f& org);
-    /// Transmittances of shadow or occlusion rays from one point (out[i] for rays[i]): one batch
-    /// query (Embree: packets) where a shadow ray ends at its first hit; ray by ray in kernels with
-    /// transparent occluders, whose filter runs at every crossing (packets measured slower there).
-    void transmittances(std::span<const Ray> rays, std::span<Color> out) const;
     /// True when a secondary ray of path weight w is worth tracing (w >= min_weight); counts the cut.
     bool worth_tracing(float w, RayCounters& counters) const;
     template <KernelFeatures K>

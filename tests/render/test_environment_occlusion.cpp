@@ -224,11 +224,13 @@ public:
     void transmittance(std::span<const Ray> rays, std::span<Color> out) const override {
         batched += rays.size();
         m_inner.transmittance(rays, out);
+        for (const Color& c : out) partial += !is_black(c) && !(c == Color(1.f));
     }
     std::string name() const override { return m_inner.name(); }
     RayOffsetPolicy ray_offset() const override { return m_inner.ray_offset(); }
     AccelStats stats() const override { return m_inner.stats(); }
     mutable std::atomic<uint64_t> batched{0};
+    mutable std::atomic<uint64_t> partial{0};  ///< answers between 0 and 1 (through transparent occluders)
 
 private:
     const Accelerator& m_inner;
@@ -236,10 +238,11 @@ private:
 
 // Which of an environment's extracted lights take a shadow ray at a point, and which occlusion
 // cells a ray, depends on their potentials alone (Ward's test), so each point's rays go to the
-// accelerator as one batch query (Embree: 16-wide packets); in an opaque scene every shadow and
-// occlusion ray does. The image and the ray counts equal those of the same rays one by one
+// accelerator as one batch query (Embree: 16-wide packets): every shadow and occlusion ray of
+// this scene does. The image and the ray counts equal those of the same rays one by one
 // (`shadow_packet=1`) bit for bit, under a map whose lights Ward's test splits (a bright patch in
-// a dimmer gradient) and with occluders on an edge (the refined cells' batches of four).
+// a dimmer gradient), with occluders on an edge (the refined cells' batches of four) and a glass
+// sphere whose shadow the lanes' transmittance products make.
 TEST(EnvironmentOcclusion, BatchedShadowQueriesEqualRayByRay) {
     Scene s = sphere_on_plane(0.5f, 0.7f);
     Sphere gold;
@@ -248,6 +251,15 @@ TEST(EnvironmentOcclusion, BatchedShadowQueriesEqualRayByRay) {
     gold.material = uint32_t(s.materials.size());
     s.materials.push_back(test::gltf_metal(Color(1.f, 0.77f, 0.34f), 0.35f));
     s.spheres.push_back(gold);
+    WhittedCoeffs glass;
+    glass.kt = Color(0.7f, 0.8f, 0.9f);
+    glass.ks = Color(0.1f);
+    glass.ior = 1.5f;
+    Sphere clear;
+    clear.center = {-1.0, 0.4, 0.6};
+    clear.radius = 0.4;
+    clear.material = add_classic_material(s, glass);
+    s.spheres.push_back(clear);
     s.cameras.front() = make_camera(CameraType::Perspective, {0, 1.5, 4}, normalize(Vec3d(0, -0.3, -1)), {0, 1, 0}, 0.7);
     Environment env = constant_environment(Color(1.f));
     auto image = std::make_shared<EnvironmentImage>(*env.image);
@@ -264,7 +276,7 @@ TEST(EnvironmentOcclusion, BatchedShadowQueriesEqualRayByRay) {
     rs.threads = 1;
     rs.integrator.min_weight = 1.f / 255.f;  // the renderer's default: Ward's test leaves dim lights untested
     const Renderer renderer(s, rs);
-    ASSERT_FALSE(renderer.kernel().transmission);
+    ASSERT_TRUE(renderer.kernel().transmission);  // shadow rays multiply transmittances
     const auto single = create_accelerator("embree:shadow_packet=1", s, renderer.view(), AccelConfig{rs.robust});
     const BatchCounter one_by_one(*single), packets(renderer.accelerator());
     RenderStats a, b;
@@ -275,6 +287,7 @@ TEST(EnvironmentOcclusion, BatchedShadowQueriesEqualRayByRay) {
     EXPECT_GT(a.rays.occlusion, 0u);
     EXPECT_EQ(packets.batched.load(), a.rays.shadow + a.rays.occlusion);
     EXPECT_EQ(one_by_one.batched.load(), packets.batched.load());
+    EXPECT_GT(packets.partial.load(), 0u);  // through the glass
     for (size_t i = 0; i < fa.beauty.size(); ++i) ASSERT_EQ(fa.beauty[i], fb.beauty[i]) << "pixel " << i;
 }
 
