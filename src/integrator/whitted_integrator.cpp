@@ -38,6 +38,30 @@ PrimaryInfo first_hit(const Hit& hit, const Vec3f& N, const WhittedCoeffs& c) {
     return {true, hit.t, N, c.kd + c.kr + c.kt, hit.prim, hit.inst};
 }
 
+/// Transmittances along the rays ray(k), k < m, of one point as one batch query of `accel`:
+/// put(k, t) for each; put(k, none) where ray(k) gives no ray. Adds the rays traced to `traced`.
+template <typename MakeRay, typename Put>
+void batch_transmittance(const Accelerator& accel, size_t m, MakeRay ray, Put put, const Color& none,
+                         uint64_t& traced) {
+    thread_local std::vector<Ray> rays;
+    thread_local std::vector<Color> through;
+    thread_local std::vector<uint32_t> slot;
+    rays.clear();
+    slot.clear();
+    for (size_t k = 0; k < m; ++k) {
+        if (const std::optional<Ray> r = ray(k)) {
+            rays.push_back(*r);
+            slot.push_back(uint32_t(k));
+        } else {
+            put(k, none);
+        }
+    }
+    traced += rays.size();
+    through.resize(rays.size());
+    accel.transmittance(std::span<const Ray>(rays), std::span<Color>(through));
+    for (size_t b = 0; b < rays.size(); ++b) put(slot[b], through[b]);
+}
+
 /// Ward's adaptive test ("Adaptive Shadow Testing for Ray Tracing", 1991) over n candidates:
 /// potential(j) is what candidate j gives if nothing blocks it (a Color, not negative);
 /// test(ids, out) sets out[k] to what arrives through the scene from candidate ids[k]. The
@@ -232,25 +256,10 @@ Color WhittedIntegrator::environment_visibility(const Shading& s, float stake, R
         if (!(dot(r.dir, s.f.Ng) > 0.f)) return std::nullopt;
         return r;
     };
-    // Transmittances along the directions local(0..m), one batch query.
-    thread_local std::vector<Ray> batch;
-    thread_local std::vector<Color> batch_through;
-    thread_local std::vector<uint32_t> batch_slot;
+    // Transmittances along the directions local(0..m), one batch query (1 below the surface).
     auto transmittance_along = [&](size_t m, auto local, auto put) {
-        batch.clear();
-        batch_slot.clear();
-        for (size_t k = 0; k < m; ++k) {
-            if (const std::optional<Ray> r = occlusion_ray(local(k))) {
-                batch.push_back(*r);
-                batch_slot.push_back(uint32_t(k));
-            } else {
-                put(k, Color(1.f));
-            }
-        }
-        counters.occlusion += batch.size();
-        batch_through.resize(batch.size());
-        m_accel.transmittance(std::span<const Ray>(batch), std::span<Color>(batch_through));
-        for (size_t b = 0; b < batch.size(); ++b) put(batch_slot[b], batch_through[b]);
+        batch_transmittance(
+            m_accel, m, [&](size_t k) { return occlusion_ray(local(k)); }, put, Color(1.f), counters.occlusion);
     };
     Color total(0.f);
     for (size_t k = 0; k < cells.size(); ++k) {
@@ -372,24 +381,15 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         return lit(e, m_accel.transmittance(*ray));
     };
     // The tested extracted lights' shadow rays, one batch query (they are known before any is traced).
-    thread_local std::vector<Ray> batch;
-    thread_local std::vector<Color> batch_shadow;
-    thread_local std::vector<uint32_t> batch_slot;
     auto shadowed_all = [&](std::span<const uint32_t> ids, std::span<Color> out) {
-        batch.clear();
-        batch_slot.clear();
-        for (size_t k = 0; k < ids.size(); ++k) {
-            out[k] = Color(0.f);
-            const Candidate& e = environment[ids[k]];
-            if (const std::optional<Ray> ray = shadow_ray(*e.light, *e.ls, origin(e))) {
-                batch.push_back(*ray);
-                batch_slot.push_back(uint32_t(k));
-            }
-        }
-        counters.shadow += batch.size();
-        batch_shadow.resize(batch.size());
-        m_accel.transmittance(std::span<const Ray>(batch), std::span<Color>(batch_shadow));
-        for (size_t b = 0; b < batch.size(); ++b) out[batch_slot[b]] = lit(environment[ids[batch_slot[b]]], batch_shadow[b]);
+        batch_transmittance(
+            m_accel, ids.size(),
+            [&](size_t k) {
+                const Candidate& e = environment[ids[k]];
+                return shadow_ray(*e.light, *e.ls, origin(e));
+            },
+            [&](size_t k, const Color& shadow) { out[k] = lit(environment[ids[k]], shadow); }, Color(0.f),
+            counters.shadow);
     };
     // The extracted lights' highlight scale depends on the material alone: once per point where
     // there are such lights (an environment), instead of once per light.
