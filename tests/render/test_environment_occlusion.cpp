@@ -53,6 +53,16 @@ Scene sphere_on_plane(float r, float kd = 1.f) {
     return s;
 }
 
+/// Adds a rough gold sphere beside sphere_on_plane's sphere.
+void add_gold_sphere(Scene& s) {
+    Sphere gold;
+    gold.center = {1.1, 0.5, 0.2};
+    gold.radius = 0.5;
+    gold.material = uint32_t(s.materials.size());
+    s.materials.push_back(test::gltf_metal(Color(1.f, 0.77f, 0.34f), 0.35f));
+    s.spheres.push_back(gold);
+}
+
 Film render(const Scene& scene, const IntegratorSettings& integrator, int size, RenderStats* stats = nullptr,
             int threads = 1, int tile = 32) {
     RenderSettings rs;
@@ -151,12 +161,7 @@ TEST(EnvironmentOcclusion, MultibounceFitAtKnownValues) {
 // adaptive anti-aliasing: the direction sets are fixed, nothing depends on the order of work.
 TEST(EnvironmentOcclusion, DeterministicAcrossThreadsAndTiles) {
     Scene s = sphere_on_plane(0.5f);
-    Sphere gold;
-    gold.center = {1.1, 0.5, 0.2};
-    gold.radius = 0.5;
-    gold.material = uint32_t(s.materials.size());
-    s.materials.push_back(test::gltf_metal(Color(1.f, 0.77f, 0.34f), 0.35f));
-    s.spheres.push_back(gold);
+    add_gold_sphere(s);
     s.cameras.front() = make_camera(CameraType::Perspective, {0, 1.5, 4}, normalize(Vec3d(0, -0.3, -1)), {0, 1, 0}, 0.7);
     test::light_with(s, constant_environment(Color(1.f)), kDefaultEnvironmentLights);
     RenderSettings rs;
@@ -245,12 +250,7 @@ private:
 // sphere whose shadow the lanes' transmittance products make.
 TEST(EnvironmentOcclusion, BatchedShadowQueriesEqualRayByRay) {
     Scene s = sphere_on_plane(0.5f, 0.7f);
-    Sphere gold;
-    gold.center = {1.1, 0.5, 0.2};
-    gold.radius = 0.5;
-    gold.material = uint32_t(s.materials.size());
-    s.materials.push_back(test::gltf_metal(Color(1.f, 0.77f, 0.34f), 0.35f));
-    s.spheres.push_back(gold);
+    add_gold_sphere(s);
     WhittedCoeffs glass;
     glass.kt = Color(0.7f, 0.8f, 0.9f);
     glass.ks = Color(0.1f);
