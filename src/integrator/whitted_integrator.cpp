@@ -363,6 +363,17 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
     };
     thread_local std::vector<Candidate> environment;
     environment.clear();
+    // A layered surface's extracted lights before their terms (potential unset), their directions
+    // and N.L, and then their terms.
+    thread_local std::vector<Candidate> layered;
+    thread_local std::vector<Vec3f> layered_l;
+    thread_local std::vector<float> layered_n_dot_l;
+    thread_local std::vector<Color> layered_terms_out;
+    if constexpr (K.layers) {
+        layered.clear();
+        layered_l.clear();
+        layered_n_dot_l.clear();
+    }
     auto origin = [&](const Candidate& e) -> const Vec3f& {
         if (!shadow_org) shadow_org = m_offset.origin(s.f.front ? s.sp.p_shadow : s.sp.p, s.sp.offset_scale, s.f.Ng);
         if (e.behind && !back_org) back_org = m_offset.origin(s.sp.p, s.sp.offset_scale, -s.f.Ng);
@@ -417,6 +428,13 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         }
         Color term;
         if constexpr (K.layers) {
+            if (s.layers && light.from_environment && cached) {
+                // Their terms are computed together after the loop (layered_terms).
+                layered.push_back({&light, &ls, Color(0.f), behind});
+                layered_l.push_back(ls.L);
+                layered_n_dot_l.push_back(n_dot_l);
+                return;
+            }
             term = s.layers ? layered_term(c, *s.layers, s.f.N, ls.L, s.f.V, n_dot_l, light.from_environment)
                             : local_term(c, s.f.N, ls.L, s.f.V, n_dot_l, light.from_environment ? environment_scale : 1.f);
         } else {
@@ -443,6 +461,22 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         for (const uint32_t l : reach) add_light(l);
     } else {
         for (uint32_t l = 0; l < uint32_t(m_view.scene().lights.size()); ++l) add_light(l);
+    }
+    if constexpr (K.layers) {
+        // A layered surface's extracted lights, in light order as the loop met them: their terms
+        // in one call (a sheen's lobe then runs four lights at a time), then as add_light above.
+        if (!layered.empty()) {
+            layered_terms_out.resize(layered.size());
+            layered_terms(c, *s.layers, s.f.N, s.f.V, layered_l, layered_n_dot_l, true, layered_terms_out);
+            for (size_t k = 0; k < layered.size(); ++k) {
+                if (is_black(layered_terms_out[k])) {
+                    ++counters.shadow_skipped_zero;
+                    continue;
+                }
+                const Candidate& e = layered[k];
+                environment.push_back({e.light, e.ls, e.ls->intensity * layered_terms_out[k], e.behind});
+            }
+        }
     }
     if (environment.empty()) return sum;
 
