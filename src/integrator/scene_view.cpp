@@ -99,12 +99,9 @@ void SceneView::derive() {
         }
     }
     m_directional_samples.assign(scene.lights.size(), LightSample{});
-    m_extracted.assign(scene.lights.size(), 0);
     for (size_t i = 0; i < scene.lights.size(); ++i)
-        if (scene.lights[i].type == LightType::Directional) {
+        if (scene.lights[i].type == LightType::Directional)
             m_directional_samples[i] = whitted::sample_light(scene.lights[i], Vec3f(0.f));
-            m_extracted[i] = scene.lights[i].from_environment;
-        }
     // Float transforms per instance; the normal matrix is inverted in double precision.
     m_xf.resize(scene.instances.size());
     for (size_t i = 0; i < scene.instances.size(); ++i) {

@@ -97,12 +97,6 @@ public:
         return m_scene.lights[light].type == LightType::Directional ? &m_directional_samples[light] : nullptr;
     }
 
-    /// True for a light extracted from the environment (always directional), from a byte per
-    /// light: the integrator tells the ~220 extracted lights apart without reading their records.
-    bool extracted(uint32_t light) const { return m_extracted[light] != 0; }
-    /// directional_sample of an extracted light (no check of its kind).
-    const LightSample& extracted_sample(uint32_t light) const { return m_directional_samples[light]; }
-
     // SurfaceFilter
     bool accept(const Ray& ray, const Hit& hit, RayKind kind) const override;
     Color transmittance(const Ray& ray, const Hit& hit) const override;
@@ -141,7 +135,6 @@ private:
     std::shared_ptr<const EnvironmentMap> m_environment;  ///< built from scene.environment
     std::vector<std::optional<Color>> m_constant_shadow_kt;  ///< per material: transmitted_light where constant
     std::vector<LightSample> m_directional_samples;  ///< per light: sample_light() of a directional one
-    std::vector<uint8_t> m_extracted;  ///< per light: 1 = from_environment and directional
 };
 
 extern template SurfacePoint SceneView::surface<true>(const Ray&, const Hit&, const RayCone&) const;

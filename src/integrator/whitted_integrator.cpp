@@ -363,17 +363,6 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
     };
     thread_local std::vector<Candidate> environment;
     environment.clear();
-    // A layered surface's extracted lights before their terms (potential unset), their directions
-    // and N.L, and then their terms.
-    thread_local std::vector<Candidate> layered;
-    thread_local std::vector<Vec3f> layered_l;
-    thread_local std::vector<float> layered_n_dot_l;
-    thread_local std::vector<Color> layered_terms_out;
-    if constexpr (K.layers) {
-        layered.clear();
-        layered_l.clear();
-        layered_n_dot_l.clear();
-    }
     auto origin = [&](const Candidate& e) -> const Vec3f& {
         if (!shadow_org) shadow_org = m_offset.origin(s.f.front ? s.sp.p_shadow : s.sp.p, s.sp.offset_scale, s.f.Ng);
         if (e.behind && !back_org) back_org = m_offset.origin(s.sp.p, s.sp.offset_scale, -s.f.Ng);
@@ -397,7 +386,7 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
             m_accel, ids.size(),
             [&](size_t k) {
                 const Candidate& e = environment[ids[k]];
-                return directional_shadow_ray(*e.ls, origin(e));
+                return shadow_ray(*e.light, *e.ls, origin(e));
             },
             [&](size_t k, const Color& shadow) { out[k] = lit(environment[ids[k]], shadow); }, Color(0.f),
             counters.shadow);
@@ -405,103 +394,55 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
     // The extracted lights' highlight scale depends on the material alone: once per point where
     // there are such lights (an environment), instead of once per light.
     const float environment_scale = m_view.environment() ? environment_highlight_scale(c.n) : 1.f;
-    // Whether a light's sample lights the point at all (counted where not): N.L and whether it
-    // comes from behind a diffusely transmitting layered surface into n_dot_l and behind.
-    auto reaches = [&](const LightSample& ls, float& n_dot_l, bool& behind) {
-        if (is_black(ls.intensity)) {  // beyond its range window or outside its spot cone
-            ++counters.shadow_skipped_unreached;
-            return false;
-        }
-        // Light only where N.L > 0 on the shading normal (or behind a diffusely transmitting
-        // layered surface); the shadow ray decides the rest.
-        n_dot_l = dot(s.f.N, ls.L);
-        behind = false;
-        if constexpr (K.layers) behind = s.layers && n_dot_l < 0.f && !is_black(s.layers->kdt);
-        if (n_dot_l <= 0.f && !behind) {
-            ++counters.shadow_skipped_facing;
-            return false;
-        }
-        return true;
-    };
-    // A light of the scene's own: its shadow ray at once.
     auto add_light = [&](uint32_t index) {
         const Light& light = m_view.scene().lights[index];
-        // Directional lights read their sample in place; the others compute it here.
+        // Directional lights (every light extracted from an environment) read their sample in
+        // place; the others compute it here.
         const LightSample* cached = m_view.directional_sample(index);
         LightSample computed;
         if (!cached) computed = sample_light(light, s.sp.p);
         const LightSample& ls = cached ? *cached : computed;
-        float n_dot_l;
-        bool behind;
-        if (!reaches(ls, n_dot_l, behind)) return;
+        if (is_black(ls.intensity)) {  // beyond its range window or outside its spot cone
+            ++counters.shadow_skipped_unreached;
+            return;
+        }
+        // Light only where N.L > 0 on the shading normal (or behind a diffusely transmitting
+        // layered surface); the shadow ray decides the rest.
+        const float n_dot_l = dot(s.f.N, ls.L);
+        bool behind = false;
+        if constexpr (K.layers) behind = s.layers && n_dot_l < 0.f && !is_black(s.layers->kdt);
+        if (n_dot_l <= 0.f && !behind) {
+            ++counters.shadow_skipped_facing;
+            return;
+        }
         Color term;
         if constexpr (K.layers) {
-            term = s.layers ? layered_term(c, *s.layers, s.f.N, ls.L, s.f.V, n_dot_l, false)
-                            : local_term(c, s.f.N, ls.L, s.f.V, n_dot_l, 1.f);
+            term = s.layers ? layered_term(c, *s.layers, s.f.N, ls.L, s.f.V, n_dot_l, light.from_environment)
+                            : local_term(c, s.f.N, ls.L, s.f.V, n_dot_l, light.from_environment ? environment_scale : 1.f);
         } else {
-            term = local_term(c, s.f.N, ls.L, s.f.V, n_dot_l, 1.f);
+            term = local_term(c, s.f.N, ls.L, s.f.V, n_dot_l, light.from_environment ? environment_scale : 1.f);
         }
         if (is_black(term)) {  // kd = 0 and the highlight below its cutoff
             ++counters.shadow_skipped_zero;
             return;
         }
-        sum += shadowed(Candidate{&light, &ls, ls.intensity * term, behind});
-    };
-    // A light extracted from the environment (directional, its sample in SceneView's table): the
-    // same steps, from SceneView's compact tables alone (the Light records, read for each of ~220
-    // lights a point, were this loop's cache misses); it becomes a candidate of the adaptive test.
-    auto add_extracted = [&](uint32_t index) {
-        const LightSample& ls = m_view.extracted_sample(index);
-        float n_dot_l;
-        bool behind;
-        if (!reaches(ls, n_dot_l, behind)) return;
-        // Only the address: the record is not read.
-        const Light* light = &m_view.scene().lights[index];
-        if constexpr (K.layers) {
-            if (s.layers) {  // their terms are computed together after the loop (layered_terms)
-                layered.push_back({light, &ls, Color(0.f), behind});
-                layered_l.push_back(ls.L);
-                layered_n_dot_l.push_back(n_dot_l);
-                return;
-            }
-        }
-        const Color term = local_term(c, s.f.N, ls.L, s.f.V, n_dot_l, environment_scale);
-        if (is_black(term)) {
-            ++counters.shadow_skipped_zero;
+        const Candidate e{&light, &ls, ls.intensity * term, behind};
+        if (!light.from_environment || !cached) {  // (an environment's lights are all directional)
+            sum += shadowed(e);
             return;
         }
         // e.ls points into SceneView's table, which outlives the adaptive test below (copying
         // the sample in stalled on reading back its own partial stores: a tenth of this loop's
         // samples).
-        environment.push_back({light, &ls, ls.intensity * term, behind});
-    };
-    auto add = [&](uint32_t index) {
-        if (m_view.extracted(index)) add_extracted(index);
-        else add_light(index);
+        environment.push_back(e);
     };
     if constexpr (K.tables) {
         // Only the lights that can reach this object (SceneAnalysis light reach).
         const std::span<const uint32_t> reach = m_view.lights_reaching(s.hit);
         counters.shadow_skipped_unreached += m_view.scene().lights.size() - reach.size();
-        for (const uint32_t l : reach) add(l);
+        for (const uint32_t l : reach) add_light(l);
     } else {
-        for (uint32_t l = 0; l < uint32_t(m_view.scene().lights.size()); ++l) add(l);
-    }
-    if constexpr (K.layers) {
-        // A layered surface's extracted lights, in light order as the loop met them: their terms
-        // in one call (a sheen's lobe then runs four lights at a time), then as add_light above.
-        if (!layered.empty()) {
-            layered_terms_out.resize(layered.size());
-            layered_terms(c, *s.layers, s.f.N, s.f.V, layered_l, layered_n_dot_l, true, layered_terms_out);
-            for (size_t k = 0; k < layered.size(); ++k) {
-                if (is_black(layered_terms_out[k])) {
-                    ++counters.shadow_skipped_zero;
-                    continue;
-                }
-                const Candidate& e = layered[k];
-                environment.push_back({e.light, e.ls, e.ls->intensity * layered_terms_out[k], e.behind});
-            }
-        }
+        for (uint32_t l = 0; l < uint32_t(m_view.scene().lights.size()); ++l) add_light(l);
     }
     if (environment.empty()) return sum;
 
@@ -510,23 +451,19 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         shadowed_all, s.weight, m_settings.min_weight, counters.shadow_skipped_dim);
 }
 
-Ray WhittedIntegrator::directional_shadow_ray(const LightSample& ls, const Vec3f& org) {
-    Ray shadow;
-    shadow.org = org;
-    shadow.dir = ls.L;
-    shadow.tfar = kInfinity;
-    return shadow;
-}
-
 std::optional<Ray> WhittedIntegrator::shadow_ray(const Light& light, const LightSample& ls, const Vec3f& org) {
-    if (light.type == LightType::Directional) return directional_shadow_ray(ls, org);
     Ray shadow;
     shadow.org = org;
-    const Vec3f to_light = Vec3f(light.position) - org;
-    const float d = length(to_light);
-    if (!(d > 0.f)) return std::nullopt;
-    shadow.dir = to_light / d;
-    shadow.tfar = d * (1.f - 1e-5f);
+    if (light.type == LightType::Directional) {
+        shadow.dir = ls.L;
+        shadow.tfar = kInfinity;
+    } else {
+        const Vec3f to_light = Vec3f(light.position) - org;
+        const float d = length(to_light);
+        if (!(d > 0.f)) return std::nullopt;
+        shadow.dir = to_light / d;
+        shadow.tfar = d * (1.f - 1e-5f);
+    }
     return shadow;
 }
 

@@ -174,8 +174,6 @@ private:
     /// The shadow ray from `org` toward the light (s_i is the accelerator's transmittance along
     /// it); none when the point is at the light itself.
     static std::optional<Ray> shadow_ray(const Light& light, const LightSample& ls, const Vec3f& org);
-    /// shadow_ray of a directional light, from its sample alone.
-    static Ray directional_shadow_ray(const LightSample& ls, const Vec3f& org);
     /// True when a secondary ray of path weight w is worth tracing (w >= min_weight); counts the cut.
     bool worth_tracing(float w, RayCounters& counters) const;
     template <KernelFeatures K>

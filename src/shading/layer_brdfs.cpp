@@ -6,8 +6,6 @@
 #include "shading/layer_brdfs.h"
 
 #include <array>
-#include <bit>
-#include <cstdint>
 #include <cmath>
 #include <atomic>
 #include <mutex>
@@ -245,99 +243,13 @@ SheenLobe sheen_lobe(float n_dot_v, float sheen_roughness) {
     lobe.l_half = sheen_l(0.5f, lobe.alpha);
     lobe.lambda_v = sheen_lambda(lobe.cos_v, lobe.alpha, lobe.l_half);
     lobe.albedo = albedo_rows(lobe.roughness);
-    const float inv_alpha = 1.f / lobe.alpha;
-    lobe.d_scale = (2.f + inv_alpha) / (2.f * kPi);
-    lobe.d_power = 0.5f * inv_alpha;
-    const float t = sq(1.f - lobe.alpha);  // as sheen_l
-    lobe.fit_a = mix(21.5473f, 25.3245f, t);
-    lobe.fit_b = mix(3.82987f, 3.32435f, t);
-    lobe.fit_c = mix(0.19823f, 0.16801f, t);
-    lobe.fit_d = mix(-1.97760f, -1.27393f, t);
-    lobe.fit_e = mix(-4.32054f, -4.85967f, t);
-    lobe.v_lambda = 1.f + lobe.lambda_v;
-    lobe.v_cos = 4.f * lobe.cos_v;
     return lobe;
 }
 
-namespace {
-
-// D V four lights at a time. The C library's powf and expf are calls the compiler cannot
-// vectorise or overlap (about 30 ns of a sheen light's term went to them and the branch between
-// the Lambda fit's halves); here they are polynomials on GCC vector types, branch-free. Element-wise
-// operations on these types are IEEE single precision, so every lane computes what the same code
-// on one float would (-ffp-contract=off). SLEEF's SSE2 functions (Debian's libsleef) were measured
-// slower than the C library's here.
-typedef float Float4 __attribute__((vector_size(16)));
-typedef int32_t Int4 __attribute__((vector_size(16)));
-
-inline Float4 splat(float x) { return Float4{x, x, x, x}; }
-
-/// log2 of positive normal floats: x = 2^e m with m in [sqrt(1/2), sqrt(2)), ln m = 2 atanh(t),
-/// t = (m - 1) / (m + 1), |t| <= 0.172, by its series to t^9 (truncation below 1e-9); absolute
-/// error about 1e-7. Zero gives -127 (callers mask it).
-inline Float4 log2_4(const Float4& x) {
-    const Int4 bits = std::bit_cast<Int4>(x);
-    Int4 e = (bits >> 23) - 127;
-    Float4 m = std::bit_cast<Float4>((bits & 0x007fffff) | 0x3f800000);
-    const Int4 big = m > splat(1.41421356f);  // lanes of -1 where true
-    m = big ? m * 0.5f : m;
-    e -= big;
-    const Float4 t = (m - 1.f) / (m + 1.f);
-    const Float4 t2 = t * t;
-    const Float4 series = t * (2.f + t2 * (2.f / 3.f + t2 * (2.f / 5.f + t2 * (2.f / 7.f + t2 * (2.f / 9.f)))));
-    return __builtin_convertvector(e, Float4) + series * 1.44269504f;
-}
-
-/// 2^y for finite y: 2^n e^(f ln 2) with n = round(y), |f| <= 1/2, the exponential by its Taylor
-/// series to degree 7 (truncation below 6e-9); 0 below 2^-126 (no subnormals), y clamped at 127.
-inline Float4 exp2_4(const Float4& y) {
-    const Int4 under = y < splat(-126.f);
-    const Float4 c = under ? splat(0.f) : (y > splat(127.f) ? splat(127.f) : y);
-    const Float4 n = (c + 12582912.f) - 12582912.f;  // round to nearest (1.5 x 2^23)
-    const Float4 z = (c - n) * 0.693147181f;
-    const Float4 p =
-        1.f + z * (1.f + z * (0.5f + z * (1.f / 6.f + z * (1.f / 24.f + z * (1.f / 120.f + z * (1.f / 720.f + z * (1.f / 5040.f)))))));
-    const Float4 r = p * std::bit_cast<Float4>((__builtin_convertvector(n, Int4) + 127) << 23);
-    return under ? splat(0.f) : r;
-}
-
-/// lobe's D V at four lights (sheen_at_light's brdf): D = d_scale (1 - (N.H)^2)^d_power, and
-/// V = 1 / ((1 + Lambda(N.V) + Lambda(N.L)) 4 N.V N.L) with Lambda the fit mirrored about 0.5.
-inline Float4 sheen_brdf_4(const SheenLobe& lobe, Float4 n_dot_h, Float4 n_dot_l) {
-    // Clamps as clamp_to: NaN gives the lower end.
-    const Float4 cos_l = n_dot_l > splat(kMinSheenCosine) ? (n_dot_l < splat(1.f) ? n_dot_l : splat(1.f)) : splat(kMinSheenCosine);
-    const Float4 h = n_dot_h > splat(0.f) ? (n_dot_h < splat(1.f) ? n_dot_h : splat(1.f)) : splat(0.f);
-    const Float4 sin2 = 1.f - h * h;
-    const Float4 d = sin2 > splat(0.f) ? lobe.d_scale * exp2_4(lobe.d_power * log2_4(sin2)) : splat(0.f);
-    const Int4 low = cos_l < splat(0.5f);
-    const Float4 x = low ? cos_l : 1.f - cos_l;  // in [0, 0.5]
-    const Float4 x_c = x > splat(0.f) ? exp2_4(lobe.fit_c * log2_4(x)) : splat(0.f);
-    const Float4 fit = lobe.fit_a / (1.f + lobe.fit_b * x_c) + lobe.fit_d * x + lobe.fit_e;
-    const Float4 lambda_l = exp2_4((low ? fit : 2.f * lobe.l_half - fit) * 1.44269504f);
-    return d / ((lobe.v_lambda + lambda_l) * (lobe.v_cos * cos_l));
-}
-
-}  // namespace
-
 SheenAtLight sheen_at_light(const SheenLobe& lobe, float n_dot_h, float n_dot_l) {
-    const Float4 brdf = sheen_brdf_4(lobe, splat(n_dot_h), splat(n_dot_l));
-    return {brdf[0], albedo_between(lobe.albedo, n_dot_l)};
-}
-
-void sheen_at_lights(const SheenLobe& lobe, std::span<const float> n_dot_h, std::span<const float> n_dot_l,
-                     std::span<SheenAtLight> out) {
-    const size_t n = out.size();
-    for (size_t k = 0; k < n; k += 4) {
-        // The last group's missing lanes repeat its first light.
-        Float4 h, l;
-        for (size_t j = 0; j < 4; ++j) {
-            const size_t i = k + j < n ? k + j : k;
-            h[j] = n_dot_h[i];
-            l[j] = n_dot_l[i];
-        }
-        const Float4 brdf = sheen_brdf_4(lobe, h, l);
-        for (size_t j = 0; j < 4 && k + j < n; ++j) out[k + j] = {brdf[j], albedo_between(lobe.albedo, l[j])};
-    }
+    const float cos_l = clamp_to(n_dot_l, kMinSheenCosine, 1.f);
+    const float brdf = charlie_distribution(n_dot_h, lobe.alpha) * sheen_visibility(cos_l, lobe.cos_v, lobe.lambda_v, lobe.alpha, lobe.l_half);
+    return {brdf, albedo_between(lobe.albedo, n_dot_l)};
 }
 
 Color iridescence_fresnel(float cos_theta1, float film_ior, float thickness_nm, const Color& base_f0) {

@@ -6,8 +6,6 @@
 // as the range's lower end). Schlick's Fresnel is `schlick()` in shading/optics.h.
 #pragma once
 
-#include <span>
-
 #include "core/vecmath.h"
 
 namespace whitted {
@@ -53,11 +51,6 @@ struct SheenLobe {
     float l_half = 0.f;       ///< the Lambda fit's log at cos 0.5 (its mirror point)
     float roughness = 1.f;    ///< sheenRoughness (the albedo table's row)
     SheenAlbedoRows albedo;   ///< the table rows of `roughness`, looked up once per lobe
-    // What sheen_at_light reads, computed once per lobe: D = d_scale (sin^2 theta_h)^d_power, the
-    // Lambda fit's coefficients at alpha, and V's denominator's parts 1 + Lambda(N.V) and 4 N.V.
-    float d_scale = 0.f, d_power = 0.f;
-    float fit_a = 0.f, fit_b = 0.f, fit_c = 0.f, fit_d = 0.f, fit_e = 0.f;
-    float v_lambda = 1.f, v_cos = 4.f;
 };
 SheenLobe sheen_lobe(float n_dot_v, float sheen_roughness);
 
@@ -67,13 +60,7 @@ struct SheenAtLight {
     float brdf;               ///< D V
     float albedo_l;           ///< sheen_albedo(n_dot_l, roughness)
 };
-/// D V is evaluated four lights at a time with polynomial exp2 and log2 (relative error of D V
-/// below 1e-5 against charlie_distribution x charlie_visibility, which call the C library); the
-/// single light takes one lane, so it equals sheen_at_lights bit for bit.
 SheenAtLight sheen_at_light(const SheenLobe& lobe, float n_dot_h, float n_dot_l);
-/// sheen_at_light of n lights: out[k] for n_dot_h[k], n_dot_l[k] (the spans have one size).
-void sheen_at_lights(const SheenLobe& lobe, std::span<const float> n_dot_h, std::span<const float> n_dot_l,
-                     std::span<SheenAtLight> out);
 
 /// Thin-film Fresnel of KHR_materials_iridescence at cos_theta1 = N.V (outside IOR 1), per channel
 /// in [0, 1]; film_ior clamped to [1, kMaxFilmIor], thickness_nm to [0, kMaxFilmThicknessNm],

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
 
 #include "shading/local_model.h"
 
@@ -113,28 +112,20 @@ WhittedCoeffs map_layered(const Material& material, const PbrSample& sample, con
     return c;
 }
 
-namespace {
-
-/// The half vector and N.H of light direction L.
-struct HalfVector {
-    Vec3f H;
-    float n_dot_h;
-};
-inline HalfVector half_vector(const Vec3f& N, const Vec3f& L, const Vec3f& V) {
+Color layered_term(const WhittedCoeffs& c, const LayerCoeffs& l, const Vec3f& N, const Vec3f& L, const Vec3f& V,
+                   float n_dot_l, bool environment_light) {
+    if (n_dot_l < 0.f) return l.kdt * -n_dot_l;  // diffuse transmission: light from behind
     const Vec3f H = normalize(L + V);
-    return {H, std::max(0.f, dot(N, H))};
-}
+    const float n_dot_h = std::max(0.f, dot(N, H));
 
-/// layered_term for n_dot_l >= 0, given the sheen's terms at the light (read only with a sheen).
-inline Color front_term(const WhittedCoeffs& c, const LayerCoeffs& l, const Vec3f& N, const Vec3f& L,
-                        const HalfVector& h, float n_dot_l, bool environment_light, const SheenAtLight& sheen) {
     // The base: its diffuse and highlight terms, scaled by the sheen's albedo at L over the one at V.
     Color base = c.kd * n_dot_l;
     const float scale = environment_light ? l.environment_scale : 1.f;
     if (!is_black(c.ks) && scale > 0.f)  // scale 0: the prefiltered map carries this lobe (local_model.h)
-        base += c.ks * ((l.anisotropic ? anisotropic_lobe(l, N, h.H) : lobe(h.n_dot_h, c.n)) * scale);
+        base += c.ks * ((l.anisotropic ? anisotropic_lobe(l, N, H) : lobe(n_dot_h, c.n)) * scale);
     Color term = base;
     if (!is_black(l.sheen)) {
+        const SheenAtLight sheen = sheen_at_light(l.sheen_lobe, n_dot_h, n_dot_l);
         const float base_l = 1.f - l.sheen_max * sheen.albedo_l;
         if (base_l < l.base_v) term = base * (l.base_v > 0.f ? base_l / l.base_v : 0.f);
         term += l.sheen * (kPi * sheen.brdf * n_dot_l);
@@ -143,42 +134,8 @@ inline Color front_term(const WhittedCoeffs& c, const LayerCoeffs& l, const Vec3
     // The coat's highlight about its own normal.
     const float coat_scale = environment_light ? l.coat_environment_scale : 1.f;
     if (l.coat > 0.f && coat_scale > 0.f && dot(l.Nc, L) > 0.f)
-        term += Color(l.coat * lobe(std::max(0.f, dot(l.Nc, h.H)), l.coat_n) * coat_scale);
+        term += Color(l.coat * lobe(std::max(0.f, dot(l.Nc, H)), l.coat_n) * coat_scale);
     return term;
-}
-
-}  // namespace
-
-Color layered_term(const WhittedCoeffs& c, const LayerCoeffs& l, const Vec3f& N, const Vec3f& L, const Vec3f& V,
-                   float n_dot_l, bool environment_light) {
-    if (n_dot_l < 0.f) return l.kdt * -n_dot_l;  // diffuse transmission: light from behind
-    const HalfVector h = half_vector(N, L, V);
-    const SheenAtLight sheen = is_black(l.sheen) ? SheenAtLight{} : sheen_at_light(l.sheen_lobe, h.n_dot_h, n_dot_l);
-    return front_term(c, l, N, L, h, n_dot_l, environment_light, sheen);
-}
-
-void layered_terms(const WhittedCoeffs& c, const LayerCoeffs& l, const Vec3f& N, const Vec3f& V,
-                   std::span<const Vec3f> L, std::span<const float> n_dot_l, bool environment_light,
-                   std::span<Color> terms) {
-    const size_t n = terms.size();
-    if (is_black(l.sheen)) {  // nothing to batch
-        for (size_t k = 0; k < n; ++k) terms[k] = layered_term(c, l, N, L[k], V, n_dot_l[k], environment_light);
-        return;
-    }
-    thread_local std::vector<HalfVector> halves;
-    thread_local std::vector<float> n_dot_h;
-    thread_local std::vector<SheenAtLight> sheen;
-    halves.resize(n);
-    n_dot_h.resize(n);
-    sheen.resize(n);
-    for (size_t k = 0; k < n; ++k) {
-        halves[k] = n_dot_l[k] < 0.f ? HalfVector{Vec3f(0.f), 0.f} : half_vector(N, L[k], V);
-        n_dot_h[k] = halves[k].n_dot_h;
-    }
-    sheen_at_lights(l.sheen_lobe, n_dot_h, n_dot_l, sheen);
-    for (size_t k = 0; k < n; ++k)
-        terms[k] = n_dot_l[k] < 0.f ? l.kdt * -n_dot_l[k]
-                                    : front_term(c, l, N, L[k], halves[k], n_dot_l[k], environment_light, sheen[k]);
 }
 
 }  // namespace whitted

@@ -11,8 +11,6 @@
 // integrator adds layered_term() per light and the coat's mirror and glossy rays.
 #pragma once
 
-#include <span>
-
 #include "core/vecmath.h"
 #include "shading/layer_brdfs.h"
 #include "shading/material_mapping.h"
@@ -75,13 +73,6 @@ WhittedCoeffs map_layered(const Material& material, const PbrSample& sample, con
 /// environment_highlight_scale of their exponent).
 Color layered_term(const WhittedCoeffs& c, const LayerCoeffs& l, const Vec3f& N, const Vec3f& L, const Vec3f& V,
                    float n_dot_l, bool environment_light);
-
-/// layered_term of n lights at once: terms[k] for unit direction L[k] with n_dot_l[k] = N.L[k],
-/// equal bit for bit to layered_term one light at a time; with a sheen its lobe runs four lights
-/// at a time (sheen_at_lights). The spans have one size.
-void layered_terms(const WhittedCoeffs& c, const LayerCoeffs& l, const Vec3f& N, const Vec3f& V,
-                   std::span<const Vec3f> L, std::span<const float> n_dot_l, bool environment_light,
-                   std::span<Color> terms);
 
 /// KHR_materials_dispersion's indices of refraction for red, green and blue:
 /// ior - h, ior, ior + h with h = (ior - 1) 0.025 dispersion.

@@ -3,8 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <span>
-#include <vector>
 
 #include "shading/layer_brdfs.h"
 #include "shading/layered_model.h"
@@ -242,42 +240,6 @@ TEST(LayeredModel, DiffuseTransmissionMovesTheDiffuseLobeBehind) {
     const WhittedCoeffs ch = map_layered(m, s, f, {}, h);
     expect_near(ch.kd, opaque.kd * 0.5f, 1e-6f);
     expect_near(h.kdt, l.kdt * 0.5f, 1e-6f);
-}
-
-TEST(LayeredModel, TermsOfManyLightsEqualOneAtATime) {
-    // layered_terms (the integrator's path for an environment's lights) against layered_term light
-    // by light, bit for bit: with and without a sheen, with a coat, an anisotropic highlight and
-    // diffuse transmission (lights behind), every count of lights up to all of them.
-    const Material m = dielectric({0.6f, 0.4f, 0.3f}, 0.5f);
-    PbrSample plain = constant_pbr_sample(m);
-    PbrSample sheen = plain;
-    sheen.sheen_color = {0.9f, 0.4f, 0.7f};
-    sheen.sheen_roughness = 0.45f;
-    PbrSample all = sheen;
-    all.clearcoat = 0.7f;
-    all.clearcoat_roughness = 0.3f;
-    all.anisotropy = 0.6f;
-    all.anisotropy_direction = {0.6f, 0.8f};
-    all.diffuse_transmission = 0.5f;
-    all.diffuse_transmission_color = {1.f, 0.8f, 0.6f};
-    const std::vector<Vec3f> ls = light_directions();
-    std::vector<float> n_dot_l;
-    for (const PbrSample* s : {&plain, &sheen, &all})
-        for (float angle : {0.2f, 1.2f}) {
-            const LayerFrame f = frame_at(angle);
-            LayerCoeffs l;
-            const WhittedCoeffs c = map_layered(m, *s, f, {}, l);
-            n_dot_l.clear();
-            for (const Vec3f& L : ls) n_dot_l.push_back(dot(f.N, L));
-            for (size_t n : {size_t(0), size_t(1), size_t(5), ls.size()}) {
-                std::vector<Color> terms(n, Color(-1.f));
-                layered_terms(c, l, f.N, f.V, std::span(ls).first(n), std::span(n_dot_l).first(n), true, terms);
-                for (size_t k = 0; k < n; ++k) {
-                    const Color one = layered_term(c, l, f.N, ls[k], f.V, n_dot_l[k], true);
-                    EXPECT_EQ(terms[k], one) << "light " << k << " of " << n;
-                }
-            }
-        }
 }
 
 TEST(LayeredModel, DispersionFollowsTheAbbeNumber) {
