@@ -130,16 +130,20 @@ std::vector<EnvironmentMap::Level> pyramid(EnvironmentMap::Level base, WorkerPoo
     return levels;
 }
 
-/// Trilinear lookup of a pyramid at a map-local direction: bilinear within a level, linear between
+/// Trilinear lookup of a pyramid at map coordinates uv: bilinear within a level, linear between
 /// the two levels around `lod` (level 0 below 0, the last level beyond it).
-Color sample_pyramid(const std::vector<EnvironmentMap::Level>& levels, const Vec3f& map_dir, float lod) {
-    const Vec2f uv = latlong_uv(map_dir);
+Color sample_pyramid_uv(const std::vector<EnvironmentMap::Level>& levels, const Vec2f& uv, float lod) {
     const int last = int(levels.size()) - 1;
     if (!(lod > 0.f)) return levels.front().bilinear(uv.x, uv.y);
     if (lod >= float(last)) return levels.back().bilinear(uv.x, uv.y);
     const int l0 = int(lod);
     const float f = lod - float(l0);
     return lerp(levels[size_t(l0)].bilinear(uv.x, uv.y), levels[size_t(l0) + 1].bilinear(uv.x, uv.y), f);
+}
+
+/// sample_pyramid_uv at a map-local direction.
+Color sample_pyramid(const std::vector<EnvironmentMap::Level>& levels, const Vec3f& map_dir, float lod) {
+    return sample_pyramid_uv(levels, latlong_uv(map_dir), lod);
 }
 
 /// What the extracted lights leave of texel c of luminance lum: scaled down to luminance
@@ -276,6 +280,16 @@ std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::L
         float t, b, n;  // h = t sin_h cos(phi) + b sin_h sin(phi) + n cos_h, in the texel's frame
         float lod;
     };
+    struct RowSample {
+        float u;        // of the sample's direction, relative to its texel's
+        float weight;   // N.L
+        // sample_pyramid_uv at the sample's v and lod, its v part done: levels[k0] alone, or
+        // lerp(levels[k0], levels[k0 + 1], f).
+        size_t k0;
+        bool two;
+        float f;
+        EnvironmentMap::Level::Rows r0, r1;
+    };
     std::vector<std::vector<Sample>> samples(kPrefilterRoughness.size());
     for (size_t k = 0; k < kPrefilterRoughness.size(); ++k) {
         if (((levels >> k) & 1u) == 0) continue;
@@ -296,19 +310,48 @@ std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::L
         EnvironmentMap::Level& level = out[rows[item].level];
         const std::vector<Sample>& pattern = samples[rows[item].level];
         const int y = rows[item].y;
+        // The pattern in the frame of the row's first texel, turned into map coordinates once: a
+        // texel x columns on is the same frame turned about the polar axis by x texels of
+        // longitude (the frame's tangent follows longitude), so its samples are the row's shifted
+        // by x / width in u, at the same v, level and weight.
+        const float u0 = 0.5f / float(level.width);
+        const Vec3f n = latlong_direction(u0, (float(y) + 0.5f) / float(level.height));
+        const float phi = (u0 - 0.5f) * 2.f * kPi;
+        const Vec3f t(-std::sin(phi), 0.f, std::cos(phi));  // toward increasing longitude
+        const Vec3f b = cross(n, t);
+        thread_local std::vector<RowSample> row;
+        row.clear();
+        float weight = 0.f;
+        for (const Sample& s : pattern) {
+            const Vec3f h = t * s.t + b * s.b + n * s.n;
+            const Vec3f l = h * (2.f * s.n) - n;
+            const float n_dot_l = dot(n, l);
+            if (n_dot_l <= 0.f) continue;
+            const Vec2f uv = latlong_uv(l);
+            RowSample r{uv.x - u0, n_dot_l, 0, false, 0.f, {}, {}};
+            const int last = int(source.size()) - 1;  // the level choice of sample_pyramid_uv
+            if (!(s.lod > 0.f)) {
+                r.k0 = 0;
+            } else if (s.lod >= float(last)) {
+                r.k0 = size_t(last);
+            } else {
+                r.k0 = size_t(s.lod);
+                r.two = true;
+                r.f = s.lod - float(r.k0);
+                r.r1 = source[r.k0 + 1].rows_at(uv.y);
+            }
+            r.r0 = source[r.k0].rows_at(uv.y);
+            row.push_back(r);
+            weight += n_dot_l;
+        }
         for (int x = 0; x < level.width; ++x) {
-            const Vec3f n = latlong_direction((float(x) + 0.5f) / float(level.width), (float(y) + 0.5f) / float(level.height));
-            Vec3f t, b;
-            tangent_frame(n, t, b);
+            const float shift = (float(x) + 0.5f) / float(level.width);
             Color sum(0.f);
-            float weight = 0.f;
-            for (const Sample& s : pattern) {
-                const Vec3f h = t * s.t + b * s.b + n * s.n;
-                const Vec3f l = h * (2.f * s.n) - n;
-                const float n_dot_l = dot(n, l);
-                if (n_dot_l <= 0.f) continue;
-                sum += sample_pyramid(source, l, s.lod) * n_dot_l;
-                weight += n_dot_l;
+            for (const RowSample& r : row) {
+                float u = r.u + shift;
+                u -= std::floor(u);  // across the seam
+                const Color c0 = source[r.k0].along(r.r0, u);
+                sum += (r.two ? lerp(c0, source[r.k0 + 1].along(r.r1, u), r.f) : c0) * r.weight;
             }
             level.texels[size_t(y) * size_t(level.width) + size_t(x)] = weight > 0.f ? sum / weight : Color(0.f);
         }
@@ -373,6 +416,32 @@ Vec3f latlong_direction(float u, float v) {
 Color EnvironmentMap::Level::bilinear(float u, float v) const {
     if (!std::isfinite(u)) u = 0.5f;
     if (!std::isfinite(v)) v = 0.5f;
+    return along(rows_at(v), u);
+}
+
+EnvironmentMap::Level::Rows EnvironmentMap::Level::rows_at(float v) const {
+    auto row = [&](int y) { return &texels[size_t(y) * size_t(width)]; };
+    Rows r;
+    // Rows: within half a texel of a pole, blend into the pole's mean (the same for every u).
+    const float y = std::clamp(v, 0.f, 1.f) * float(height) - 0.5f;
+    if (y < 0.f) {
+        r.a_pole = pole_top;
+        r.b = row(0);
+        r.f = std::clamp(2.f * (y + 0.5f), 0.f, 1.f);
+    } else if (y > float(height - 1)) {
+        r.a = row(height - 1);
+        r.b_pole = pole_bottom;
+        r.f = std::clamp(2.f * (y - float(height - 1)), 0.f, 1.f);
+    } else {
+        const int y0 = std::min(int(y), height - 1), y1 = std::min(y0 + 1, height - 1);
+        r.a = row(y0);
+        r.b = row(y1);
+        r.f = y - float(y0);
+    }
+    return r;
+}
+
+Color EnvironmentMap::Level::along(const Rows& r, float u) const {
     // Columns wrap around the seam at u = 0 = 1.
     const float x = u * float(width) - 0.5f;
     const float fx0 = std::floor(x);
@@ -380,16 +449,9 @@ Color EnvironmentMap::Level::bilinear(float u, float v) const {
     int xa = int(fx0);
     if (xa < 0 || xa >= width) xa = ((xa % width) + width) % width;
     const int xb = xa + 1 == width ? 0 : xa + 1;
-    auto row = [&](int y) {
-        const Color* r = &texels[size_t(y) * size_t(width)];
-        return lerp(r[xa], r[xb], fx);
-    };
-    // Rows: within half a texel of a pole, blend into the pole's mean (the same for every u).
-    const float y = std::clamp(v, 0.f, 1.f) * float(height) - 0.5f;
-    if (y < 0.f) return lerp(pole_top, row(0), std::clamp(2.f * (y + 0.5f), 0.f, 1.f));
-    if (y > float(height - 1)) return lerp(row(height - 1), pole_bottom, std::clamp(2.f * (y - float(height - 1)), 0.f, 1.f));
-    const int y0 = std::min(int(y), height - 1), y1 = std::min(y0 + 1, height - 1);
-    return lerp(row(y0), row(y1), y - float(y0));
+    const Color a = r.a ? lerp(r.a[xa], r.a[xb], fx) : r.a_pole;
+    const Color b = r.b ? lerp(r.b[xa], r.b[xb], fx) : r.b_pole;
+    return lerp(a, b, r.f);
 }
 
 // ---- SH9 ----------------------------------------------------------------------------------------

@@ -205,6 +205,16 @@ public:
         Color pole_top{0.f}, pole_bottom{0.f};  ///< mean of row 0 and of the last row: the value at v = 0 and v = 1
         /// Bilinear at (u, v) in [0, 1]^2: wrap in u; within half a texel of a pole, blend into the pole's mean.
         Color bilinear(float u, float v) const;
+        /// bilinear's part that depends on v alone, for many lookups at one v:
+        /// bilinear(u, v) = along(rows_at(v), u) for finite u and v.
+        struct Rows {
+            const Color* a = nullptr;  ///< the upper row, or null: the constant a_pole
+            const Color* b = nullptr;  ///< the lower row, or null: the constant b_pole
+            Color a_pole{0.f}, b_pole{0.f};
+            float f = 0.f;             ///< the weight of b
+        };
+        Rows rows_at(float v) const;
+        Color along(const Rows& rows, float u) const;
     };
 
 private:

@@ -375,6 +375,34 @@ TEST(Environment, PrefilteredSunSpreadsWithRoughness) {
     EXPECT_GT(map.prefiltered(sun * std::cos(off) + side * std::sin(off), 1.f).y, 0.f);
 }
 
+TEST(Environment, PrefilterKeepsASymmetryAboutThePole) {
+    // A map that depends on latitude alone (bands of sky, horizon and ground) prefilters to one
+    // that does too: every texel of a row reads its row's sample pattern turned about the pole
+    // (the frame's tangent follows longitude), so only longitude changes between texels and the
+    // prefiltered rows are constant. What remains is the lookup's own rounding (its latitude from
+    // the direction, to the last bit); a pattern turned differently at each texel (an arbitrary
+    // tangent, as before) gave 5.6e-3.
+    const EnvironmentMap map(make_environment(256, 128,
+                                              [](int, int y) {
+                                                  const float v = float(y) / 128.f;
+                                                  return Color(4.f * v * v, v < 0.5f ? 2.f : 0.1f, 0.3f + v);
+                                              }),
+                             1);
+    float worst = 0.f;
+    for (float y : {0.95f, 0.5f, 0.1f, -0.3f, -0.9f}) {
+        const float s = std::sqrt(1.f - y * y);
+        for (float r : {0.3f, 0.5f, 0.75f, 1.f}) {
+            const Color first = map.prefiltered({s, y, 0.f}, r);
+            for (int k = 1; k < 16; ++k) {
+                const float phi = 0.39f * float(k);
+                worst = std::max(worst, max_relative_error(map.prefiltered({s * std::cos(phi), y, s * std::sin(phi)}, r), first));
+            }
+        }
+    }
+    std::printf("[ prefilter ] largest relative change along a latitude: %.2g\n", worst);
+    EXPECT_LT(worst, 1e-5f);
+}
+
 TEST(Environment, SameResultForAnyThreadCount) {
     const Environment env = bundled("sunset");
     const EnvironmentMap one(env, 1), two(env, 2);
