@@ -130,20 +130,28 @@ std::vector<EnvironmentMap::Level> pyramid(EnvironmentMap::Level base, WorkerPoo
     return levels;
 }
 
-/// Trilinear lookup of a pyramid at map coordinates uv: bilinear within a level, linear between
-/// the two levels around `lod` (level 0 below 0, the last level beyond it).
-Color sample_pyramid_uv(const std::vector<EnvironmentMap::Level>& levels, const Vec2f& uv, float lod) {
-    const int last = int(levels.size()) - 1;
-    if (!(lod > 0.f)) return levels.front().bilinear(uv.x, uv.y);
-    if (lod >= float(last)) return levels.back().bilinear(uv.x, uv.y);
+/// The levels of a pyramid of `count` levels a trilinear lookup at `lod` reads: level k0 alone
+/// (level 0 below 0, the last level beyond it), or k0 and k0 + 1 mixed by f.
+struct LevelBlend {
+    size_t k0 = 0;
+    bool two = false;
+    float f = 0.f;
+};
+LevelBlend level_blend(size_t count, float lod) {
+    const int last = int(count) - 1;
+    if (!(lod > 0.f)) return {0, false, 0.f};
+    if (lod >= float(last)) return {size_t(last), false, 0.f};
     const int l0 = int(lod);
-    const float f = lod - float(l0);
-    return lerp(levels[size_t(l0)].bilinear(uv.x, uv.y), levels[size_t(l0) + 1].bilinear(uv.x, uv.y), f);
+    return {size_t(l0), true, lod - float(l0)};
 }
 
-/// sample_pyramid_uv at a map-local direction.
+/// Trilinear lookup of a pyramid at a map-local direction: bilinear within a level, linear between
+/// the two levels around `lod` (level_blend).
 Color sample_pyramid(const std::vector<EnvironmentMap::Level>& levels, const Vec3f& map_dir, float lod) {
-    return sample_pyramid_uv(levels, latlong_uv(map_dir), lod);
+    const Vec2f uv = latlong_uv(map_dir);
+    const LevelBlend b = level_blend(levels.size(), lod);
+    const Color c0 = levels[b.k0].bilinear(uv.x, uv.y);
+    return b.two ? lerp(c0, levels[b.k0 + 1].bilinear(uv.x, uv.y), b.f) : c0;
 }
 
 /// What the extracted lights leave of texel c of luminance lum: scaled down to luminance
@@ -283,11 +291,8 @@ std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::L
     struct RowSample {
         float u;        // of the sample's direction, relative to its texel's
         float weight;   // N.L
-        // sample_pyramid_uv at the sample's v and lod, its v part done: levels[k0] alone, or
-        // lerp(levels[k0], levels[k0 + 1], f).
-        size_t k0;
-        bool two;
-        float f;
+        // sample_pyramid at the sample's v and lod, its v part done (r0 of level k0, r1 of k0 + 1)
+        LevelBlend levels;
         EnvironmentMap::Level::Rows r0, r1;
     };
     std::vector<std::vector<Sample>> samples(kPrefilterRoughness.size());
@@ -328,19 +333,9 @@ std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::L
             const float n_dot_l = dot(n, l);
             if (n_dot_l <= 0.f) continue;
             const Vec2f uv = latlong_uv(l);
-            RowSample r{uv.x - u0, n_dot_l, 0, false, 0.f, {}, {}};
-            const int last = int(source.size()) - 1;  // the level choice of sample_pyramid_uv
-            if (!(s.lod > 0.f)) {
-                r.k0 = 0;
-            } else if (s.lod >= float(last)) {
-                r.k0 = size_t(last);
-            } else {
-                r.k0 = size_t(s.lod);
-                r.two = true;
-                r.f = s.lod - float(r.k0);
-                r.r1 = source[r.k0 + 1].rows_at(uv.y);
-            }
-            r.r0 = source[r.k0].rows_at(uv.y);
+            RowSample r{uv.x - u0, n_dot_l, level_blend(source.size(), s.lod), {}, {}};
+            r.r0 = source[r.levels.k0].rows_at(uv.y);
+            if (r.levels.two) r.r1 = source[r.levels.k0 + 1].rows_at(uv.y);
             row.push_back(r);
             weight += n_dot_l;
         }
@@ -350,8 +345,9 @@ std::vector<EnvironmentMap::Level> prefilter(const std::vector<EnvironmentMap::L
             for (const RowSample& r : row) {
                 float u = r.u + shift;
                 u -= std::floor(u);  // across the seam
-                const Color c0 = source[r.k0].along(r.r0, u);
-                sum += (r.two ? lerp(c0, source[r.k0 + 1].along(r.r1, u), r.f) : c0) * r.weight;
+                const LevelBlend& b = r.levels;
+                const Color c0 = source[b.k0].along(r.r0, u);
+                sum += (b.two ? lerp(c0, source[b.k0 + 1].along(r.r1, u), b.f) : c0) * r.weight;
             }
             level.texels[size_t(y) * size_t(level.width) + size_t(x)] = weight > 0.f ? sum / weight : Color(0.f);
         }
