@@ -251,12 +251,13 @@ Command register_bench_process(CLI::App& bench) {
     app->add_option("--povray", o->povray.povray, "--vs-povray: the POV-Ray program (a path, or a name on the PATH)")
         ->capture_default_str();
     app->add_option("--pov-scenes", o->povray.scenes,
-                    "--vs-povray: scenes: whitted1980, rings, tree, or classic scene files (spheres, cylinders, cones, "
+                    "--vs-povray: scenes: whitted1980, the SPD-style rings, tree, balls, tetra, mount, or classic scene "
+                    "files (spheres, cylinders, cones, "
                     "discs, meshes, planes, classic materials, point and directional lights)")
         ->delimiter(',')
-        ->check(CLI::IsMember({"whitted1980", "rings", "tree"}) | CLI::ExistingFile)
+        ->check(CLI::IsMember({"whitted1980", "rings", "tree", "balls", "tetra", "mount"}) | CLI::ExistingFile)
         ->capture_default_str();
-    app->add_option("--spd-size", o->povray.spd_size, "--vs-povray: SPD size factor of rings and tree")
+    app->add_option("--spd-size", o->povray.spd_size, "--vs-povray: SPD size factor of the SPD-style scenes")
         ->check(CLI::Range(1, 6))
         ->capture_default_str();
     app->add_option("--pov-scale", o->povray.scale, "--vs-povray: image sizes times this (1: 1920x1080 and 512x512)")

@@ -1,9 +1,14 @@
 // SPD-style scenes of analytic quadrics and their tessellation (see spd_scenes.h).
 #include "benchmarks/spd_scenes.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/error.h"
 
@@ -27,7 +32,7 @@ uint32_t classic(Scene& s, const char* name, Color kd, Color ks, float n) {
 void add_cylinder(Scene& s, const Vec3d& a, const Vec3d& b, double r0, double r1, uint32_t material) {
     Quadric q = make_quadric(r0 == r1 ? QuadricKind::Cylinder : QuadricKind::Cone, a, b, r0, r1, true);
     q.material = material;
-    q.name = "q" + std::to_string(s.quadrics.size());
+    q.name = fmt::format("q{}", s.quadrics.size());
     s.quadrics.push_back(q);
 }
 
@@ -85,7 +90,118 @@ void branch(Scene& s, const Vec3d& base, const Vec3d& dir, double length, double
         branch(s, tip, normalize(dir * c + axis * (sign * sn)), length * 0.75, radius * 0.7, depth - 1, wood, leaf);
 }
 
+/// Sphereflake (SPD "balls"): nine spheres a third of the size on each sphere, six about its
+/// equator and three on a ring 60 degrees above it, the equator taken about the axis from its
+/// parent; `depth` more levels below this one.
+void flake(Scene& s, const Vec3d& centre, double radius, const Vec3d& axis, int depth, uint32_t material) {
+    add_sphere(s, centre, radius, material);
+    if (depth == 0) return;
+    const Vec3d u = normalize(cross(axis, std::fabs(axis.y) < 0.9 ? Vec3d{0, 1, 0} : Vec3d{1, 0, 0}));
+    const Vec3d v = cross(axis, u);
+    const double child = radius / 3.0;
+    for (int k = 0; k < 9; ++k) {
+        const bool upper = k >= 6;
+        const double azimuth = upper ? kPiD / 6.0 + 2.0 * kPiD * (k - 6) / 3.0 : 2.0 * kPiD * k / 6.0;
+        const double elevation = upper ? kPiD / 3.0 : 0.0;
+        const Vec3d d = (u * std::cos(azimuth) + v * std::sin(azimuth)) * std::cos(elevation) + axis * std::sin(elevation);
+        flake(s, centre + d * (radius + child), child, d, depth - 1, material);
+    }
+}
+
+/// A triangle with its face normal at each corner (own vertices: flat shading).
+void add_flat_triangle(Mesh& m, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+    const Vec3f n(normalize(cross(b - a, c - a)));
+    for (const Vec3d& p : {a, b, c}) {
+        m.indices.push_back(uint32_t(m.positions.size()));
+        m.positions.push_back(Vec3f(p));
+        m.normals.push_back(n);
+    }
+}
+
+/// Sierpinski tetrahedron (SPD "tetra"): the four corner tetrahedra of half the size, `depth`
+/// times; each leaf's four faces.
+void sierpinski(Mesh& m, const std::array<Vec3d, 4>& v, int depth) {
+    if (depth == 0) {
+        add_flat_triangle(m, v[0], v[2], v[1]);
+        add_flat_triangle(m, v[0], v[1], v[3]);
+        add_flat_triangle(m, v[1], v[2], v[3]);
+        add_flat_triangle(m, v[2], v[0], v[3]);
+        return;
+    }
+    for (int k = 0; k < 4; ++k) {
+        std::array<Vec3d, 4> w;
+        for (int i = 0; i < 4; ++i) w[size_t(i)] = (v[size_t(k)] + v[size_t(i)]) * 0.5;
+        sierpinski(m, w, depth - 1);
+    }
+}
+
+/// A value in [-1, 1] from a lattice point (integer hash; the same for every run and platform).
+double lattice_noise(int i, int j) {
+    uint32_t h = uint32_t(i) * 0x9E3779B1u ^ (uint32_t(j) + 0x7F4A7C15u) * 0x85EBCA77u;
+    h ^= h >> 15;
+    h *= 0x2C1B3C6Du;
+    h ^= h >> 12;
+    h *= 0x297A2D39u;
+    h ^= h >> 15;
+    return double(h) / double(0xFFFFFFFFu) * 2.0 - 1.0;
+}
+
+/// Fractal mountain (SPD "mount"): a triangle of 4^levels triangles whose heights come from
+/// midpoint displacement on a triangular lattice (each new point the mean of its edge's ends plus
+/// noise halving with the level, `roughness` at the first), so neighbouring triangles share their
+/// edges' heights, over a pyramid `peak` high; the rim stays at height 0 and nothing goes below it
+/// (no gap under the edge to look into).
+Mesh fractal_mountain(int levels, const Vec3d& a, const Vec3d& b, const Vec3d& c, double peak, double roughness) {
+    const int n = 1 << levels;  // lattice points (i, j), i + j <= n: a + (b - a) i / n + (c - a) j / n
+    std::vector<double> h(size_t((n + 1) * (n + 1)), 0.0);
+    auto at = [&](int i, int j) -> double& { return h[size_t(i * (n + 1) + j)]; };
+    double scale = roughness;
+    for (int step = n; step > 1; step /= 2, scale *= 0.5) {
+        const int half = step / 2;
+        // The midpoints of this level's edges: along i, along j, and the diagonals.
+        for (int i = 0; i <= n; i += half)
+            for (int j = 0; i + j <= n; j += half) {
+                if (i % step == 0 && j % step == 0) continue;  // a point of an earlier level
+                if (i == 0 || j == 0 || i + j == n) continue;    // the rim stays on the ground
+                int i0 = i, j0 = j, i1 = i, j1 = j;
+                if (i % step != 0 && j % step != 0) i0 -= half, j0 += half, i1 += half, j1 -= half;  // diagonal
+                else if (i % step != 0) i0 -= half, i1 += half;
+                else j0 -= half, j1 += half;
+                at(i, j) = 0.5 * (at(i0, j0) + at(i1, j1)) + scale * lattice_noise(i, j);
+            }
+    }
+    Mesh m;
+    m.name = "mountain";
+    auto point = [&](int i, int j) {
+        const double u = double(i) / n, v = double(j) / n;
+        const Vec3d p = a + (b - a) * u + (c - a) * v;
+        // A peak over the centre (3 min(barycentric) is 1 there, 0 on the rim), roughened by the noise.
+        const double peak_height = peak * 3.0 * std::min({u, v, 1.0 - u - v});
+        return Vec3d{p.x, p.y + std::max(0.0, peak_height + at(i, j)), p.z};
+    };
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; i + j < n; ++j) {
+            add_flat_triangle(m, point(i, j), point(i + 1, j), point(i, j + 1));
+            if (i + j + 1 < n) add_flat_triangle(m, point(i + 1, j), point(i + 1, j + 1), point(i, j + 1));
+        }
+    return m;
+}
+
+void add_mesh(Scene& s, Mesh m, uint32_t material) {
+    m.material = material;
+    s.meshes.push_back(std::move(m));
+    Instance inst;
+    inst.mesh = uint32_t(s.meshes.size() - 1);
+    inst.node_name = s.meshes.back().name;
+    s.instances.push_back(inst);
+}
+
 }  // namespace
+
+const std::vector<std::string>& spd_scene_names() {
+    static const std::vector<std::string> names{"rings", "tree", "balls", "tetra", "mount"};
+    return names;
+}
 
 Scene make_spd_scene(const std::string& name, int size) {
     Scene s;
@@ -121,8 +237,37 @@ Scene make_spd_scene(const std::string& name, int size) {
         const uint32_t leaf = classic(s, "leaf", Color(0.2f, 0.6f, 0.2f), Color(0.3f), 30.f);
         branch(s, {0, 0, 0}, {0, 1, 0}, 1.2, 0.12, 4 + size, wood, leaf);
         stage(s, {4.5, 3.5, 6.0}, {0, 2.0, 0}, 0.0, 10.0);
+    } else if (name == "balls") {
+        const uint32_t ball = classic(s, "ball", Color(0.6f, 0.45f, 0.35f), Color(0.5f), 40.f);
+        flake(s, {0, 1.4, 0}, 1.0, {0, 1, 0}, size, ball);
+        stage(s, {3.2, 3.4, 5.2}, {0, 1.2, 0}, 0.0, 12.0);
+    } else if (name == "tetra") {
+        const uint32_t matte = classic(s, "tetra", Color(0.75f, 0.7f, 0.45f), Color(0.f), 1.f);
+        Mesh m;
+        m.name = "tetra";
+        const double e = 3.0;  // edge
+        const double r = e / std::sqrt(3.0), height = e * std::sqrt(2.0 / 3.0);
+        std::array<Vec3d, 4> v;
+        for (int k = 0; k < 3; ++k) v[size_t(k)] = {r * std::cos(2.0 * kPiD * k / 3.0), 0.0, r * std::sin(2.0 * kPiD * k / 3.0)};
+        v[3] = {0.0, height, 0.0};
+        sierpinski(m, v, size + 1);
+        add_mesh(s, std::move(m), matte);
+        stage(s, {3.0, 3.6, 5.0}, {0, 1.0, 0}, 0.0, 12.0);
+    } else if (name == "mount") {
+        const uint32_t rock = classic(s, "rock", Color(0.5f, 0.45f, 0.35f), Color(0.f), 1.f);
+        const uint32_t mirror = classic(s, "mirror", Color(0.1f), Color(0.8f), 60.f);
+        const uint32_t glass = classic(s, "glass", Color(0.02f), Color(0.1f), 80.f);
+        s.materials[glass].classic.kt = Color(0.85f);
+        s.materials[glass].classic.ior = 1.5f;
+        s.materials[glass].classic.thin = false;
+        add_mesh(s, fractal_mountain(size + 3, {-4.0, 0.0, 3.0}, {4.0, 0.0, 3.0}, {0.0, 0.0, -4.0}, 2.0, 1.2), rock);
+        add_sphere(s, {-1.6, 2.6, 1.2}, 0.5, glass);
+        add_sphere(s, {0.0, 3.2, 0.2}, 0.5, mirror);
+        add_sphere(s, {1.6, 2.6, 1.2}, 0.5, mirror);
+        add_sphere(s, {0.0, 2.4, 2.2}, 0.5, mirror);
+        stage(s, {0.0, 4.5, 8.5}, {0, 1.2, 0}, -0.01, 12.0);
     } else {
-        throw Error(fmt::format("unknown SPD scene '{}': expected rings or tree", name));
+        throw Error(fmt::format("unknown SPD scene '{}': expected one of {}", name, fmt::join(spd_scene_names(), ", ")));
     }
     return s;
 }

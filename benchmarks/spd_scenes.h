@@ -4,18 +4,28 @@
 //   - rings: a pyramid of rings, each a closed polygon of cylinders with a sphere at every joint
 //     (SPD "rings"), over a ground disc;
 //   - tree: a branching tree of truncated cones with a sphere at every branch tip (SPD "tree"),
-//     over a ground disc.
+//     over a ground disc;
+//   - balls: a sphereflake, nine spheres a third of the size on every sphere (SPD "balls");
+//   - tetra: a Sierpinski tetrahedron of flat triangles (SPD "tetra");
+//   - mount: a fractal mountain of flat triangles with four spheres above it, one of glass (SPD
+//     "mount").
+// (SPD's gears and teapot are not made.)
 // Classic materials (mirror-like, as the SPD's), three point lights and a camera.
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "scene/scene.h"
 
 namespace whitted::app {
 
-/// The scene `name` ("rings" or "tree") at `size` (SPD's size factor: rings 1..; tree depth
-/// 4 + size). Throws whitted::Error for another name.
+/// The names make_spd_scene() knows: rings, tree, balls, tetra, mount.
+const std::vector<std::string>& spd_scene_names();
+
+/// The scene `name` at `size` (SPD's size factor: rings size + 1 levels; tree depth 4 + size;
+/// balls size levels below the first sphere, 1 + 9 + ... + 9^size spheres; tetra 4^(size + 1)
+/// tetrahedra; mount 4^(size + 3) triangles). Throws whitted::Error for another name.
 Scene make_spd_scene(const std::string& name, int size);
 
 /// The same scene with every cylinder and cone tessellated into `segments` side quads (smooth

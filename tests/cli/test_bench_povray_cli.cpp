@@ -24,11 +24,12 @@ using whitted::test::run;
 
 TEST(BenchPovrayCli, BothProgramsScoredOnTheSameScenes) {
     const fs::path out = whitted::test::scratch_dir("whitted_bench_povray_cli", "small");
-    const Result r = run("bench process --vs-povray --pov-scenes whitted1980,rings --spd-size 1 --pov-scale 0.05 "
-                         "--repeat 1 --threads 1 --out '" + out.string() + "'");
+    const Result r = run("bench process --vs-povray --pov-scenes whitted1980,rings,balls,tetra,mount --spd-size 1 "
+                         "--pov-scale 0.05 --repeat 1 --threads 1 --out '" + out.string() + "'");
     ASSERT_EQ(r.code, 0) << r.out << r.err;
     const std::vector<std::map<std::string, std::string>> rows = read_csv(out / "versus_povray.csv");
-    ASSERT_EQ(rows.size(), 2u * (8u + 9u));  // whitted's 8 settings and POV-Ray's 9, per scene
+    constexpr size_t kScenes = 5;
+    ASSERT_EQ(rows.size(), kScenes * (13u + 13u));  // whitted's 13 settings and POV-Ray's 13, per scene
     std::map<std::string, int> per_program;
     for (const auto& row : rows) {
         ++per_program[row.at("program")];
@@ -36,17 +37,18 @@ TEST(BenchPovrayCli, BothProgramsScoredOnTheSameScenes) {
         EXPECT_GT(num(row, "cpu_seconds"), 0.0);
         EXPECT_GT(num(row, "psnr_db"), 15.0) << row.at("scene") << " " << row.at("program") << " " << row.at("setting");
     }
-    EXPECT_EQ(per_program["whitted"], 16);
-    EXPECT_EQ(per_program["povray"], 18);
+    EXPECT_EQ(per_program["whitted"], int(kScenes) * 13);
+    EXPECT_EQ(per_program["povray"], int(kScenes) * 13);
     // The converged images of both programs agree (a flipped camera, a shifted checker, a wrong
     // index of refraction or a missing light would not).
     const std::regex agree(R"(the references, whitted's against POV-Ray's: ([0-9.]+|inf) dB)");
     int scenes = 0;
     for (auto it = std::sregex_iterator(r.out.begin(), r.out.end(), agree); it != std::sregex_iterator(); ++it, ++scenes)
         EXPECT_GT(std::stod((*it)[1]), 36.0) << r.out;  // 41-48 dB measured
-    EXPECT_EQ(scenes, 2) << r.out;
+    EXPECT_EQ(scenes, int(kScenes)) << r.out;
     EXPECT_NE(r.out.find("at POV-Ray +AM1 +A0.3 +R3"), std::string::npos) << r.out;
-    EXPECT_TRUE(fs::exists(out / "povray" / "rings.pov"));
+    for (const char* name : {"rings", "balls", "tetra", "mount"})
+        EXPECT_TRUE(fs::exists(out / "povray" / (std::string(name) + ".pov"))) << name;
     EXPECT_TRUE(fs::exists(out / "povray" / "whitted1980.json"));
 }
 

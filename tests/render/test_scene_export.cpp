@@ -4,9 +4,13 @@
 // written faithfully is refused with the item named.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <regex>
 #include <string>
+#include <utility>
 
 #include "benchmarks/scene_export.h"
 #include "benchmarks/spd_scenes.h"
@@ -44,7 +48,7 @@ size_t count(const std::string& text, const std::string& what) {
 }
 
 TEST(SceneExport, SceneFileRoundTripRendersTheSameImage) {
-    for (const std::string name : {"whitted1980", "rings", "tree"}) {
+    for (const std::string name : {"whitted1980", "rings", "tree", "balls", "tetra", "mount"}) {
         SCOPED_TRACE(name);
         const Scene original = name == "whitted1980" ? import_scene_file(kWhitted1980) : app::make_spd_scene(name, 1);
         const app::ExportSettings es = app::export_settings(original, 64, 48);
@@ -97,6 +101,73 @@ TEST(SceneExport, PovraySceneHoldsEveryObjectOnce) {
     EXPECT_EQ(count(r, "\ndisc {"), discs);
     EXPECT_EQ(count(r, "\nsphere {"), rings.spheres.size());
     EXPECT_EQ(count(r, "fade_power 2"), rings.lights.size());  // inverse-square lights
+}
+
+// The SPD-style scenes without quadrics of their own: the counts their size factor gives, and the
+// properties that make them the scenes they are named after.
+TEST(SpdScenes, SphereflakeTetraAndMountainFollowTheSizeFactor) {
+    EXPECT_EQ(app::spd_scene_names().size(), 5u);
+    for (int size = 1; size <= 2; ++size) {
+        SCOPED_TRACE(size);
+        // balls: 1 + 9 + ... + 9^size spheres, each child a third of its parent and touching it.
+        const Scene balls = app::make_spd_scene("balls", size);
+        EXPECT_EQ(balls.spheres.size(), size == 1 ? 10u : 91u);
+        const Sphere& root = balls.spheres[0];
+        for (size_t k = 1; k <= 9; ++k) {
+            const Sphere& child = balls.spheres[size == 1 ? k : 1 + (k - 1) * 10];
+            EXPECT_NEAR(child.radius, root.radius / 3.0, 1e-12);
+            EXPECT_NEAR(length(child.center - root.center), root.radius + child.radius, 1e-9);
+        }
+        for (const Sphere& sp : balls.spheres) EXPECT_GT(sp.center.y - sp.radius, 0.0);  // above the ground
+
+        // tetra: 4^(size + 1) tetrahedra of 4 faces, every face of the same area, inside the big one.
+        const Scene tetra = app::make_spd_scene("tetra", size);
+        ASSERT_EQ(tetra.meshes.size(), 1u);
+        const Mesh& t = tetra.meshes[0];
+        EXPECT_EQ(t.triangle_count(), size_t(4) << (2 * (size + 1)));
+        double area0 = -1.0;
+        for (size_t f = 0; f < t.triangle_count(); ++f) {
+            const Vec3d a(t.positions[t.indices[3 * f]]), b(t.positions[t.indices[3 * f + 1]]),
+                c(t.positions[t.indices[3 * f + 2]]);
+            const double area = 0.5 * length(cross(b - a, c - a));
+            if (area0 < 0.0) area0 = area;
+            EXPECT_NEAR(area, area0, 1e-5 * area0);
+            EXPECT_GE(std::min({a.y, b.y, c.y}), 0.0);
+        }
+
+        // mount: 4^(size + 3) triangles that share their edges (no crack: each edge inside is met
+        // by exactly two triangles at the same two points, each rim edge by one, on the ground),
+        // and four spheres above it, one of them glass.
+        const Scene mount = app::make_spd_scene("mount", size);
+        ASSERT_EQ(mount.meshes.size(), 1u);
+        const Mesh& m = mount.meshes[0];
+        EXPECT_EQ(m.triangle_count(), size_t(1) << (2 * (size + 3)));
+        std::map<std::pair<std::array<float, 3>, std::array<float, 3>>, int> edges;
+        auto key = [](const Vec3f& p) { return std::array<float, 3>{p.x, p.y, p.z}; };
+        for (size_t f = 0; f < m.triangle_count(); ++f)
+            for (int e = 0; e < 3; ++e) {
+                auto p = key(m.positions[m.indices[3 * f + size_t(e)]]), q = key(m.positions[m.indices[3 * f + size_t((e + 1) % 3)]]);
+                ++edges[std::minmax(p, q)];
+            }
+        size_t rim = 0;
+        for (const auto& [edge, n] : edges) {
+            EXPECT_LE(n, 2);
+            if (n == 1) {
+                ++rim;
+                EXPECT_EQ(edge.first[1], 0.f);
+                EXPECT_EQ(edge.second[1], 0.f);
+            }
+        }
+        EXPECT_EQ(rim, size_t(3) << (size + 3));
+        float top = 0.f;
+        for (const Vec3f& p : m.positions) top = std::max(top, p.y);
+        EXPECT_GT(top, 1.0f);  // a mountain, not a plain
+        ASSERT_EQ(mount.spheres.size(), 4u);
+        int glass = 0;
+        for (const Sphere& sp : mount.spheres) glass += !is_black(mount.materials[sp.material].classic.kt);
+        EXPECT_EQ(glass, 1);
+    }
+    EXPECT_THROW(app::make_spd_scene("gears", 1), Error);
 }
 
 TEST(SceneExport, RefusesWhatItCannotWriteFaithfully) {
