@@ -149,16 +149,20 @@ int run_versus_povray(const VersusPovrayOptions& o) {
                 o.repeat, povray.c_str());
 
     for (const std::string& name : o.scenes) {
-        // The SPD-style scenes at 512x512; the classic scene and other scene files at their own
-        // size (render.width/height), else 1920x1080.
+        // The SPD-style scenes at 512x512; the classic scene at 1920x1080 (issue 44's size, not
+        // the 800x600 its file renders at); other scene files at their own size
+        // (render.width/height), else 1920x1080.
         Scene scene;
         int width = 512, height = 512;
         const std::vector<std::string>& spd = spd_scene_names();
         const bool is_spd = std::find(spd.begin(), spd.end(), name) != spd.end();
         if (is_spd) {
             scene = make_spd_scene(name, o.spd_size);
+        } else if (name == "whitted1980") {
+            scene = import_scene_file(kWhitted1980);
+            width = 1920, height = 1080;
         } else {
-            scene = import_scene_file(name == "whitted1980" ? kWhitted1980 : name);
+            scene = import_scene_file(name);
             width = scene.settings.width.value_or(1920);
             height = scene.settings.height.value_or(scene.settings.width ? width * 9 / 16 : 1080);
         }
