@@ -386,9 +386,7 @@ TEST(Cli, InfoPrintsCounts) {
 
 /// Writes a small scene file into a fresh folder and returns its path.
 fs::path write_scene_file(const std::string& name, const std::string& text) {
-    const fs::path dir = fs::temp_directory_path() / ("whitted_cli_scene_" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    const fs::path p = dir / name;
+    const fs::path p = whitted::test::process_folder("whitted_cli_scene") / name;
     std::ofstream(p) << text;
     return p;
 }

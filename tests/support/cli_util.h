@@ -4,6 +4,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <gtest/gtest.h>
+
+#include <algorithm>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
@@ -29,12 +32,36 @@ inline std::string slurp(const std::filesystem::path& p) {
     return ss.str();
 }
 
+/// The per-process folders process_folder() made: removed when the test program ends with every
+/// test passed, kept after a failure (to look into). UnitTest's instance is never destroyed, so it
+/// is still there when this static is.
+struct ProcessFolders {
+    std::vector<std::filesystem::path> paths;
+    ~ProcessFolders() {
+        if (!::testing::UnitTest::GetInstance()->Passed()) return;
+        std::error_code ec;
+        for (const std::filesystem::path& p : paths) std::filesystem::remove_all(p, ec);
+    }
+};
+
+/// <tmp>/<prefix>_<pid>, created if needed (per process, so parallel ctest runs do not share it)
+/// and removed at the end of a passing run (ProcessFolders).
+inline std::filesystem::path process_folder(const std::string& prefix) {
+    static ProcessFolders folders;
+    std::string name = prefix;  // appended, not `prefix + "_" + ...` (a -Wrestrict false positive)
+    name += '_';
+    name += std::to_string(::getpid());
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / name;
+    if (std::find(folders.paths.begin(), folders.paths.end(), dir) == folders.paths.end()) folders.paths.push_back(dir);
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
 /// Runs `exe` with `args` (shell-quoted by the caller), stdin from /dev/null; stdout and stderr go
 /// through files in a per-process scratch folder.
 inline Result run_program(const std::string& exe, const std::string& args) {
     static int counter = 0;
-    const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("whitted_cli_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
+    const std::filesystem::path dir = process_folder("whitted_cli");
     const std::filesystem::path out = dir / ("out" + std::to_string(counter) + ".txt");
     const std::filesystem::path err = dir / ("err" + std::to_string(counter++) + ".txt");
     const std::string cmd = std::string("'") + exe + "' " + args + " >'" + out.string() + "' 2>'" +
@@ -52,13 +79,9 @@ inline Result run_program(const std::string& exe, const std::string& args) {
 inline Result run(const std::string& args) { return run_program(WHITTED_EXE, args); }
 #endif
 
-/// A folder for one test's files, created if needed: <tmp>/<prefix>_<pid>/<name> (per process, so
-/// parallel ctest runs do not share it).
+/// A folder for one test's files, created if needed: <tmp>/<prefix>_<pid>/<name> (process_folder).
 inline std::filesystem::path scratch_dir(const std::string& prefix, const std::string& name) {
-    std::string folder = prefix;  // appended, not `prefix + "_" + ...` (a -Wrestrict false positive)
-    folder += '_';
-    folder += std::to_string(::getpid());
-    const std::filesystem::path dir = std::filesystem::temp_directory_path() / folder / name;
+    const std::filesystem::path dir = process_folder(prefix) / name;
     std::filesystem::create_directories(dir);
     return dir;
 }
