@@ -65,12 +65,12 @@ def check(root):
 
 
 def self_test():
-    root = tempfile.mkdtemp(prefix="cli_size_")
-    os.makedirs(os.path.join(root, "apps", "whitted"))
-    body = "\n".join(f"    x += {i};" for i in range(70))
-    with open(os.path.join(root, "apps", "whitted", "main.cpp"), "w") as f:
-        f.write("int short_one(int x) {\n    return x;\n}\n\nint long_one(int x) {\n" + body + "\n    return x;\n}\n")
-    problems = check(root)
+    with tempfile.TemporaryDirectory(prefix="cli_size_") as root:
+        os.makedirs(os.path.join(root, "apps", "whitted"))
+        body = "\n".join(f"    x += {i};" for i in range(70))
+        with open(os.path.join(root, "apps", "whitted", "main.cpp"), "w") as f:
+            f.write("int short_one(int x) {\n    return x;\n}\n\nint long_one(int x) {\n" + body + "\n    return x;\n}\n")
+        problems = check(root)
     ok = len(problems) == 1 and "long_one" in problems[0] and "73 lines" in problems[0]
     print(("ok" if ok else "FAILED") + ": " + "; ".join(problems))
     return 0 if ok else 1

@@ -11,6 +11,7 @@ Usage: check_layers.py ROOT       check the checkout at ROOT; one line per viola
 """
 import os
 import re
+import shutil
 import sys
 import tempfile
 
@@ -127,7 +128,11 @@ def self_test():
     }
     failed = 0
     for name, (files, expect) in cases.items():
-        problems = check(tree(files))
+        root = tree(files)
+        try:
+            problems = check(root)
+        finally:
+            shutil.rmtree(root, ignore_errors=True)
         ok = (not problems) if expect is None else any(expect in p for p in problems)
         print(f"{'ok' if ok else 'FAILED'}: {name}: {problems or 'no problem'}")
         failed += not ok
