@@ -251,11 +251,11 @@ Command register_bench_process(CLI::App& bench) {
     app->add_option("--povray", o->povray.povray, "--vs-povray: the POV-Ray program (a path, or a name on the PATH)")
         ->capture_default_str();
     app->add_option("--pov-scenes", o->povray.scenes,
-                    "--vs-povray: scenes: whitted1980, the SPD-style rings, tree, balls, tetra, mount, or classic scene "
-                    "files (spheres, cylinders, cones, "
-                    "discs, meshes, planes, classic materials, point and directional lights)")
+                    "--vs-povray: scenes: whitted1980, the SPD-style rings, tree, balls, tetra, mount, gears, or classic "
+                    "scene files (spheres, cylinders, cones, discs, meshes, planes, classic materials, point and "
+                    "directional lights)")
         ->delimiter(',')
-        ->check(CLI::IsMember({"whitted1980", "rings", "tree", "balls", "tetra", "mount"}) | CLI::ExistingFile)
+        ->check(CLI::IsMember({"whitted1980", "rings", "tree", "balls", "tetra", "mount", "gears"}) | CLI::ExistingFile)
         ->capture_default_str();
     app->add_option("--spd-size", o->povray.spd_size, "--vs-povray: SPD size factor of the SPD-style scenes")
         ->check(CLI::Range(1, 6))

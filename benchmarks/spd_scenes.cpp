@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -187,6 +188,26 @@ Mesh fractal_mountain(int levels, const Vec3d& a, const Vec3d& b, const Vec3d& c
     return m;
 }
 
+/// A gear (SPD "gears"): `teeth` trapezoid teeth between radii `inner` and `outer` about the
+/// y axis, `thickness` high, as flat triangles: the two faces (fans from the centre; the
+/// outline is star-shaped about it) and the side walls.
+void add_gear(Mesh& m, const Vec3d& centre, double inner, double outer, double thickness, int teeth, double turn) {
+    std::vector<Vec3d> outline;  // counter-clockwise seen from +y, four points a tooth
+    for (int k = 0; k < teeth; ++k)
+        for (const auto& [frac, r] : {std::pair{0.0, inner}, std::pair{0.15, outer}, std::pair{0.45, outer}, std::pair{0.6, inner}}) {
+            const double a = turn + 2.0 * kPiD * (double(k) + frac) / double(teeth);
+            outline.push_back({r * std::cos(a), 0.0, -r * std::sin(a)});
+        }
+    const Vec3d up{0.0, thickness, 0.0};
+    for (size_t i = 0; i < outline.size(); ++i) {
+        const Vec3d a = centre + outline[i], b = centre + outline[(i + 1) % outline.size()];
+        add_flat_triangle(m, centre + up, a + up, b + up);  // top face
+        add_flat_triangle(m, centre, b, a);                 // bottom face
+        add_flat_triangle(m, a, b, b + up);                 // side wall
+        add_flat_triangle(m, a, b + up, a + up);
+    }
+}
+
 void add_mesh(Scene& s, Mesh m, uint32_t material) {
     m.material = material;
     s.meshes.push_back(std::move(m));
@@ -199,7 +220,7 @@ void add_mesh(Scene& s, Mesh m, uint32_t material) {
 }  // namespace
 
 const std::vector<std::string>& spd_scene_names() {
-    static const std::vector<std::string> names{"rings", "tree", "balls", "tetra", "mount"};
+    static const std::vector<std::string> names{"rings", "tree", "balls", "tetra", "mount", "gears"};
     return names;
 }
 
@@ -266,6 +287,23 @@ Scene make_spd_scene(const std::string& name, int size) {
         add_sphere(s, {1.6, 2.6, 1.2}, 0.5, mirror);
         add_sphere(s, {0.0, 2.4, 2.2}, 0.5, mirror);
         stage(s, {0.0, 4.5, 8.5}, {0, 1.2, 0}, -0.01, 12.0);
+    } else if (name == "gears") {
+        // (size + 1)^2 gears of 16 teeth on a grid, their teeth reaching over to the neighbours';
+        // every other one raised above them and turned half a tooth; shiny metal.
+        const uint32_t metal = classic(s, "gear", Color(0.55f, 0.5f, 0.45f), Color(0.5f), 30.f);
+        Mesh m;
+        m.name = "gears";
+        const int n = size + 1, teeth = 16;
+        const double inner = 0.5, outer = 0.62, pitch = 2.0 * inner + 0.1;
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                const bool odd = (i + j) % 2 == 1;
+                const Vec3d c{(double(i) - 0.5 * double(n - 1)) * pitch, odd ? 0.25 : 0.0, (double(j) - 0.5 * double(n - 1)) * pitch};
+                add_gear(m, c, inner, outer, 0.2, teeth, odd ? kPiD / teeth : 0.0);
+            }
+        add_mesh(s, std::move(m), metal);
+        const double extent = 0.5 * double(n) * pitch;
+        stage(s, {extent * 1.2, extent * 1.6, extent * 2.0}, {0, 0, 0}, -0.01, extent * 4.0);
     } else {
         throw Error(fmt::format("unknown SPD scene '{}': expected one of {}", name, fmt::join(spd_scene_names(), ", ")));
     }

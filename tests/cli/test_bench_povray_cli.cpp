@@ -24,11 +24,11 @@ using whitted::test::run;
 
 TEST(BenchPovrayCli, BothProgramsScoredOnTheSameScenes) {
     const fs::path out = whitted::test::scratch_dir("whitted_bench_povray_cli", "small");
-    const Result r = run("bench process --vs-povray --pov-scenes whitted1980,rings,balls,tetra,mount --spd-size 1 "
+    const Result r = run("bench process --vs-povray --pov-scenes whitted1980,rings,balls,tetra,mount,gears --spd-size 1 "
                          "--pov-scale 0.05 --repeat 1 --threads 1 --out '" + out.string() + "'");
     ASSERT_EQ(r.code, 0) << r.out << r.err;
     const std::vector<std::map<std::string, std::string>> rows = read_csv(out / "versus_povray.csv");
-    constexpr size_t kScenes = 5;
+    constexpr size_t kScenes = 6;
     ASSERT_EQ(rows.size(), kScenes * (13u + 13u));  // whitted's 13 settings and POV-Ray's 13, per scene
     std::map<std::string, int> per_program;
     for (const auto& row : rows) {
@@ -47,7 +47,7 @@ TEST(BenchPovrayCli, BothProgramsScoredOnTheSameScenes) {
         EXPECT_GT(std::stod((*it)[1]), 36.0) << r.out;  // 41-48 dB measured
     EXPECT_EQ(scenes, int(kScenes)) << r.out;
     EXPECT_NE(r.out.find("at POV-Ray +AM1 +A0.3 +R3"), std::string::npos) << r.out;
-    for (const char* name : {"rings", "balls", "tetra", "mount"})
+    for (const char* name : {"rings", "balls", "tetra", "mount", "gears"})
         EXPECT_TRUE(fs::exists(out / "povray" / (std::string(name) + ".pov"))) << name;
     EXPECT_TRUE(fs::exists(out / "povray" / "whitted1980.json"));
 }

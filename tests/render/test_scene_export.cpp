@@ -48,7 +48,7 @@ size_t count(const std::string& text, const std::string& what) {
 }
 
 TEST(SceneExport, SceneFileRoundTripRendersTheSameImage) {
-    for (const std::string name : {"whitted1980", "rings", "tree", "balls", "tetra", "mount"}) {
+    for (const std::string name : {"whitted1980", "rings", "tree", "balls", "tetra", "mount", "gears"}) {
         SCOPED_TRACE(name);
         const Scene original = name == "whitted1980" ? import_scene_file(kWhitted1980) : app::make_spd_scene(name, 1);
         const app::ExportSettings es = app::export_settings(original, 64, 48);
@@ -104,9 +104,9 @@ TEST(SceneExport, PovraySceneHoldsEveryObjectOnce) {
 }
 
 // The SPD-style scenes without quadrics of their own: the counts their size factor gives, and the
-// properties that make them the scenes they are named after.
+// properties that make them the scenes they are named after (closed, crack-free meshes).
 TEST(SpdScenes, SphereflakeTetraAndMountainFollowTheSizeFactor) {
-    EXPECT_EQ(app::spd_scene_names().size(), 5u);
+    EXPECT_EQ(app::spd_scene_names().size(), 6u);
     for (int size = 1; size <= 2; ++size) {
         SCOPED_TRACE(size);
         // balls: 1 + 9 + ... + 9^size spheres, each child a third of its parent and touching it.
@@ -166,8 +166,20 @@ TEST(SpdScenes, SphereflakeTetraAndMountainFollowTheSizeFactor) {
         int glass = 0;
         for (const Sphere& sp : mount.spheres) glass += !is_black(mount.materials[sp.material].classic.kt);
         EXPECT_EQ(glass, 1);
+
+        // gears: (size + 1)^2 closed gears of 16 teeth (every edge met by exactly two triangles).
+        const Scene gears = app::make_spd_scene("gears", size);
+        ASSERT_EQ(gears.meshes.size(), 1u);
+        const Mesh& g = gears.meshes[0];
+        EXPECT_EQ(g.triangle_count(), size_t((size + 1) * (size + 1)) * 16 * 4 * 4);
+        std::map<std::pair<std::array<float, 3>, std::array<float, 3>>, int> gear_edges;
+        for (size_t f = 0; f < g.triangle_count(); ++f)
+            for (int e = 0; e < 3; ++e)
+                ++gear_edges[std::minmax(key(g.positions[g.indices[3 * f + size_t(e)]]),
+                                         key(g.positions[g.indices[3 * f + size_t((e + 1) % 3)]]))];
+        for (const auto& [edge, n] : gear_edges) EXPECT_EQ(n, 2);
     }
-    EXPECT_THROW(app::make_spd_scene("gears", 1), Error);
+    EXPECT_THROW(app::make_spd_scene("teapot", 1), Error);
 }
 
 TEST(SceneExport, RefusesWhatItCannotWriteFaithfully) {
