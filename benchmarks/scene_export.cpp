@@ -1,6 +1,8 @@
 // Classic scenes written as whitted scene files and as POV-Ray scenes (see scene_export.h).
 #include "benchmarks/scene_export.h"
 
+#include <array>
+#include <charconv>
 #include <cmath>
 #include <functional>
 #include <optional>
@@ -26,8 +28,20 @@ std::string what(const Scene& scene) { return scene.source.empty() ? std::string
                             what(scene), item));
 }
 
+/// A float as the double of its shortest decimal form (std::to_chars), so that the file says 0.55
+/// rather than 0.550000011920929 and reads back as the same float (checked; else the float itself).
+double short_float(float f) {
+    std::array<char, 32> buf;
+    const auto [end, ec] = std::to_chars(buf.data(), buf.data() + buf.size(), f);
+    if (ec != std::errc()) return double(f);
+    double d = 0.0;
+    const auto [at, ec2] = std::from_chars(buf.data(), end, d);
+    return ec2 == std::errc() && at == end && float(d) == f ? d : double(f);
+}
+
 Json vec(const Vec3d& v) { return Json::array({v.x, v.y, v.z}); }
-Json col(const Color& c) { return Json::array({c.x, c.y, c.z}); }
+Json vecf(const Vec3f& v) { return Json::array({short_float(v.x), short_float(v.y), short_float(v.z)}); }
+Json col(const Color& c) { return vecf(c); }
 
 /// The 16 numbers of a scene file's `matrix` (column-major).
 Json column_major(const Mat4d& m) {
@@ -148,8 +162,8 @@ std::string to_scene_file(const Scene& scene, const ExportSettings& s) {
     for (const Instance& in : scene.instances) {
         const Mesh& mesh = scene.meshes[in.mesh];
         Json pos = Json::array(), nrm = Json::array();
-        for (const Vec3f& p : mesh.positions) pos.push_back(Json::array({p.x, p.y, p.z}));
-        for (const Vec3f& n : mesh.normals) nrm.push_back(Json::array({n.x, n.y, n.z}));
+        for (const Vec3f& p : mesh.positions) pos.push_back(vecf(p));
+        for (const Vec3f& n : mesh.normals) nrm.push_back(vecf(n));
         Json o = {{"type", "mesh"}, {"positions", pos}, {"indices", mesh.indices}};
         if (!nrm.empty()) o["normals"] = nrm;
         o["material"] = material(mesh.material);
@@ -178,7 +192,8 @@ std::string to_scene_file(const Scene& scene, const ExportSettings& s) {
         lights.push_back(o);
     }
     j["lights"] = lights;
-    return j.dump(1) + "\n";
+    // Compact: a mesh's numbers one per line made the exported files 3x longer and slower to read.
+    return j.dump() + "\n";
 }
 
 // ---- POV-Ray 3.7 ----------------------------------------------------------------------------------
