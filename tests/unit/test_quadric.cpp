@@ -87,6 +87,15 @@ TEST(Quadric, DiscAndAnnulus) {
     ASSERT_EQ(crossings(ring, {2.5, 5, 3}, {0, -1, 0}, t), 1);
     EXPECT_EQ(crossings(disc, {3.5, 5, 3}, {0, -1, 0}, t), 0);  // outside
     EXPECT_EQ(crossings(disc, {0, 2, 3}, {1, 0, 0}, t), 0);     // in its plane
+    // Behind the origin (t = -3, -1e-4): left out, from either side of the plane; from a point in
+    // the plane the crossing at t = 0 is kept, as is one just in front of the origin.
+    EXPECT_EQ(crossings(disc, {1.5, 5, 3}, {0, 1, 0}, t), 0);
+    EXPECT_EQ(crossings(disc, {1.5, -1, 3}, {0, -1, 0}, t), 0);
+    EXPECT_EQ(crossings(disc, {1.5, 2.0001, 3}, {0, 1, 0}, t), 0);
+    ASSERT_EQ(crossings(disc, {1.5, 2, 3}, {0.6, 0.8, 0}, t), 1);
+    EXPECT_EQ(t[0], 0.0);
+    ASSERT_EQ(crossings(disc, {1.5, 2.0001, 3}, {0, -1, 0}, t), 1);
+    EXPECT_NEAR(t[0], 1e-4, 1e-15);
     const QuadricPoint p = quadric_point(disc, {2, 2.0000001, 3});
     EXPECT_NEAR(p.p.y, 2.0, 1e-15);
     EXPECT_NEAR(p.n.y, 1.0, 1e-15);

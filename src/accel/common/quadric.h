@@ -151,13 +151,26 @@ inline int inside_spans(const SideQuadratic& f, Span out[2]) {
 }  // namespace quadric_detail
 
 /// Every crossing of the quadric's surface by the ray's whole line, in ascending order of t
-/// (0, 1 or 2 of them), in world-ray parameters: the caller keeps those in its (tnear, tfar].
+/// (0, 1 or 2 of them), in world-ray parameters: the caller keeps those in its (tnear, tfar]
+/// (tnear >= 0). A disc's crossing clearly behind the origin (t < 0) is left out.
 /// face[i] names the surface crossed (QuadricPoint::part: 0 the side or a disc, 1 the base cap,
 /// 2 the top cap), decided by the same comparison that chose t, so a ray through a rim gets the
 /// face it crossed. Degenerate input (zero direction, NaN) gives none.
 inline int quadric_crossings(const QuadricShape& q, const Vec3d& world_org, const Vec3d& world_dir, double t[2],
                              uint8_t face[2]) {
     using namespace quadric_detail;
+    if (q.kind == QuadricKind::Disc) {
+        // The plane z = 0 is crossed at t = -o.z / d.z (object space keeps the world ray's t): behind
+        // the origin when o.z and d.z have the same sign. Where o.z stands clear of its rounding,
+        // no caller keeps that crossing: skip the transforms and the re-centring (a scene's ground
+        // disc meets every ray that leaves upwards, shadow rays and mirror rays alike).
+        const Mat4d& m = q.object_from_world;
+        const double ox = m(2, 0) * world_org.x, oy = m(2, 1) * world_org.y, oz = m(2, 2) * world_org.z;
+        const double o_z = ox + oy + oz + m(2, 3);
+        const double d_z = m(2, 0) * world_dir.x + m(2, 1) * world_dir.y + m(2, 2) * world_dir.z;
+        const double rounding = 1e-9 * (std::fabs(ox) + std::fabs(oy) + std::fabs(oz) + std::fabs(m(2, 3)));
+        if (((o_z > 0.0 && d_z > 0.0) || (o_z < 0.0 && d_z < 0.0)) && std::fabs(o_z) > rounding) return 0;
+    }
     if (q.line_misses(world_org, world_dir)) return 0;
     const Vec3d o0 = q.object_from_world.apply_point(world_org);
     const Vec3d d = q.object_from_world.apply_vector(world_dir);
