@@ -653,7 +653,9 @@ private:
                 add_scanned_sphere(f, sphere_count))
                 continue;
             const std::string ptr = sub("/objects", i);
-            const Json o = scene_file::parse_object(m_doc, i);
+            Json o;  // an exporter's plain mesh without nlohmann's lexer (scan_mesh), else the general parse
+            if (!scene_file::scan_mesh(std::string_view(m_doc.text).substr(begin, end - begin), o))
+                o = scene_file::parse_object(m_doc, i);
             if (!o.is_object()) expected(o, ptr, "an object (sphere, cylinder, cone, disc, plane, box or mesh)");
             const std::string type = choice(
                 require(o, "type", ptr, "an object",

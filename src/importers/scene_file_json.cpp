@@ -6,6 +6,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <unordered_set>
 
@@ -411,6 +412,123 @@ bool scan_number(std::string_view t, size_t& i, double& out) {
 }
 
 }  // namespace
+
+namespace {
+
+/// A JSON number at t[i] as nlohmann::json stores it: an integer as int64 (with a sign) or uint64,
+/// anything else as a correctly rounded double. False when out of range (nlohmann then falls back
+/// to a double, or the general path reports it).
+bool scan_json_number(std::string_view t, size_t& i, Json& out) {
+    const size_t begin = i;
+    bool integer = true;
+    while (i < t.size() && (std::isdigit(static_cast<unsigned char>(t[i])) || t[i] == '-' || t[i] == '+' ||
+                            t[i] == '.' || t[i] == 'e' || t[i] == 'E')) {
+        integer &= t[i] != '.' && t[i] != 'e' && t[i] != 'E';
+        ++i;
+    }
+    if (i == begin || i - begin > 40) return false;
+    const char* first = t.data() + begin;
+    const char* last = t.data() + i;
+    if (integer && *first == '-') {
+        int64_t v = 0;
+        const auto r = std::from_chars(first, last, v);
+        if (r.ec != std::errc() || r.ptr != last) return false;
+        out = v;
+    } else if (integer) {
+        uint64_t v = 0;
+        const auto r = std::from_chars(first, last, v);
+        if (r.ec != std::errc() || r.ptr != last) return false;
+        out = v;
+    } else {
+        double v = 0;
+        const auto r = std::from_chars(first, last, v);
+        if (r.ec != std::errc() || r.ptr != last || !std::isfinite(v)) return false;
+        out = v;
+    }
+    return true;
+}
+
+/// An array at t[i] of numbers, or (`nested`) of arrays of numbers; i past it.
+bool scan_number_array(std::string_view t, size_t& i, Json& out, bool nested) {
+    if (i >= t.size() || t[i] != '[') return false;
+    out = Json::array();
+    Json::array_t& a = out.get_ref<Json::array_t&>();
+    i = skip_ws(t, i + 1);
+    if (i < t.size() && t[i] == ']') {
+        ++i;
+        return true;
+    }
+    while (true) {
+        Json v;
+        if (i < t.size() && t[i] == '[') {
+            if (!nested || !scan_number_array(t, i, v, false)) return false;
+        } else if (!scan_json_number(t, i, v)) {
+            return false;
+        }
+        a.push_back(std::move(v));
+        i = skip_ws(t, i);
+        if (i < t.size() && t[i] == ']') {
+            ++i;
+            return true;
+        }
+        if (i >= t.size() || t[i] != ',') return false;
+        i = skip_ws(t, i + 1);
+    }
+}
+
+}  // namespace
+
+bool scan_mesh(std::string_view t, Json& out) {
+    enum : unsigned { kType = 1, kPositions = 2, kIndices = 4, kNormals = 8, kMaterial = 16, kName = 32, kTransform = 64 };
+    unsigned seen = 0;
+    out = Json::object();
+    size_t i = skip_ws(t, 0);
+    if (i >= t.size() || t[i] != '{') return false;
+    i = skip_ws(t, i + 1);
+    while (true) {
+        std::string_view key, text;
+        if (!scan_plain_string(t, i, key)) return false;
+        i = skip_ws(t, i);
+        if (i >= t.size() || t[i] != ':') return false;
+        i = skip_ws(t, i + 1);
+        unsigned bit = 0;
+        Json value;
+        if (key == "type" || key == "material" || key == "name") {
+            if (!scan_plain_string(t, i, text) || (key == "type" && text != "mesh")) return false;
+            value = std::string(text);
+            bit = key == "type" ? kType : key == "material" ? kMaterial : kName;
+        } else if (key == "positions" || key == "indices" || key == "normals") {
+            if (!scan_number_array(t, i, value, true)) return false;
+            bit = key == "positions" ? kPositions : key == "indices" ? kIndices : kNormals;
+        } else if (key == "transform") {  // exactly {"matrix": [numbers]}
+            std::string_view matrix;
+            if (i >= t.size() || t[i] != '{') return false;
+            i = skip_ws(t, i + 1);
+            if (!scan_plain_string(t, i, matrix) || matrix != "matrix") return false;
+            i = skip_ws(t, i);
+            if (i >= t.size() || t[i] != ':') return false;
+            i = skip_ws(t, i + 1);
+            Json numbers;
+            if (!scan_number_array(t, i, numbers, false)) return false;
+            i = skip_ws(t, i);
+            if (i >= t.size() || t[i] != '}') return false;
+            ++i;
+            value = Json::object();
+            value["matrix"] = std::move(numbers);
+            bit = kTransform;
+        } else {
+            return false;
+        }
+        if (seen & bit) return false;
+        seen |= bit;
+        out[std::string(key)] = std::move(value);
+        i = skip_ws(t, i);
+        if (i < t.size() && t[i] == '}') break;
+        if (i >= t.size() || t[i] != ',') return false;
+        i = skip_ws(t, i + 1);
+    }
+    return skip_ws(t, i + 1) == t.size() && (seen & (kType | kPositions)) == (kType | kPositions);
+}
 
 bool scan_sphere(std::string_view t, SphereFields& f) {
     enum : unsigned { kType = 1, kCenter = 2, kRadius = 4, kMaterial = 8, kName = 16 };

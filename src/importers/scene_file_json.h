@@ -56,6 +56,15 @@ struct SphereFields {
 /// checks and errors). The fast path of files with many spheres: no DOM per element.
 bool scan_sphere(std::string_view e, SphereFields& f);
 
+/// Whether element text `e` (valid JSON) is a mesh object of the plain form an exporter writes:
+/// the keys "type" (the string "mesh"), "positions", optionally "indices" and "normals" (arrays of
+/// numbers, flat or of arrays of numbers), "material" and "name" (strings without escapes) and
+/// "transform" ({"matrix": [numbers]}), each once, in any order. Then `out` is the value
+/// nlohmann::json would parse (the same number types and values), read without its lexer: the
+/// fast path of files with large inline meshes, whose checks read_mesh still makes. False for
+/// anything else, which parse_object reads.
+bool scan_mesh(std::string_view e, Json& out);
+
 /// Where the JSON pointer `pointer` is in valid JSON `text`: byte offsets of the value and (for
 /// an object member) of its key; when a duplicate key occurs the last member counts (as in the
 /// parsed value). When the pointer cannot be followed to the end, the deepest value reached is

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "importers/scene_file.h"
+#include "importers/scene_file_json.h"
 #include "importers/scene_loader.h"
 #include "importers/scene_report.h"
 #include "core/error.h"
@@ -349,6 +350,63 @@ TEST(SceneFile, SphereFastPathMatchesTheGeneralReader) {
     EXPECT_CONTAINS(std::string(unknown.what()), "unknown material 'nope'");
     const Error zero = error_of(doc(R"("objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 0}])"));
     EXPECT_EQ(zero.location().pointer, "/objects/0/radius");
+}
+
+// Plain mesh objects (as the bench's exporter writes them) are read without nlohmann's lexer
+// (scan_mesh); the value must be the one nlohmann parses, number types included (an integer
+// index stays an integer, -0 an integer 0, -0.0 a negative double), so read_mesh sees the same
+// input and makes the same checks. Anything else (another key, a duplicate, an escape, a
+// transform that is not a plain matrix, a number out of range) is left to the general parse.
+TEST(SceneFile, MeshFastPathParsesAsNlohmannDoes) {
+    for (const char* text : {
+             R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]]})",
+             R"({"type":"mesh","positions":[0,0,0,1.5,-0,0,0,1e3,-0.0],"indices":[0,1,2],"material":"m","name":"n"})",
+             R"( { "normals" : [ [0, 0, 1], [0, 0, 1], [0, 0, 1] ], "type" : "mesh",
+                   "positions" : [ [0.30000000000000004, 2.5E-3, 123456789012], [1, 0, 0], [0, 1, 0] ],
+                   "indices" : [ [0, 1, 2] ], "transform" : { "matrix" : [1,0,0,0, 0,1,0,0, 0,0,1,0, 2,3,4,1] } } )",
+             R"({"type": "mesh", "positions": [], "indices": []})"}) {
+        SCOPED_TRACE(text);
+        scene_file::Json fast;
+        ASSERT_TRUE(scene_file::scan_mesh(text, fast));
+        EXPECT_EQ(fast.dump(), scene_file::Json::parse(text).dump());
+    }
+    for (const char* text : {
+             R"({"type": "mesh", "positions": [[0, 0, 0]], "comment": "x"})",
+             R"({"type": "sphere", "positions": [[0, 0, 0]]})",
+             R"({"type": "mesh", "positions": [[0, 0, 0]], "positions": [[1, 1, 1]]})",
+             R"({"type": "mesh", "name": "a\u00e9", "positions": [[0, 0, 0]]})",
+             R"({"type": "mesh", "positions": [[0, 0, 0]], "transform": {"translate": [1, 0, 0]}})",
+             R"({"type": "mesh", "positions": [[0, 0, 1e999]]})",
+             R"({"type": "mesh", "positions": [[0, 0, 99999999999999999999]]})",
+             R"({"type": "mesh", "positions": [[[0, 0, 0]]]})",
+             R"({"type": "mesh", "positions": [["0", 0, 0]]})",
+             R"({"type": "mesh", "indices": [0, 1, 2]})"}) {
+        scene_file::Json fast;
+        EXPECT_FALSE(scene_file::scan_mesh(text, fast)) << text;
+    }
+    // Whole files: the same mesh through the fast path and (with a "comment") the general one.
+    auto file = [](bool comment) {
+        return doc(std::string(R"("materials": {"m": {"kd": 1}}, "objects": [{"type": "mesh", "material": "m", )") +
+                   (comment ? R"("comment": "x", )" : "") +
+                   R"("positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.5]], "indices": [0, 1, 2, 1, 3, 2],
+                      "transform": {"matrix": [2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 1, 2, 3, 1]}}])");
+    };
+    const Scene fast = load_json(file(false), {}, "fast.json");
+    const Scene general = load_json(file(true), {}, "general.json");
+    ASSERT_EQ(fast.meshes.size(), 1u);
+    ASSERT_EQ(general.meshes.size(), 1u);
+    EXPECT_EQ(fast.meshes[0].name, general.meshes[0].name);
+    EXPECT_EQ(fast.meshes[0].indices, general.meshes[0].indices);
+    ASSERT_EQ(fast.meshes[0].positions.size(), general.meshes[0].positions.size());
+    for (size_t k = 0; k < fast.meshes[0].positions.size(); ++k) {
+        EXPECT_EQ(fast.meshes[0].positions[k], general.meshes[0].positions[k]);
+        EXPECT_EQ(fast.meshes[0].normals[k], general.meshes[0].normals[k]);
+    }
+    EXPECT_EQ(fast.instances[0].world_from_object(0, 3), 1.0);
+    EXPECT_EQ(fast.instances[0].world_from_object(1, 1), 2.0);
+    // The fast path's value still meets read_mesh's checks, located in the file.
+    const Error bad = error_of(doc(R"("objects": [{"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [0, 1, 7]}])"));
+    EXPECT_EQ(bad.location().pointer, "/objects/0/indices/2");
 }
 
 TEST(SceneFile, InfinitePlanes) {
