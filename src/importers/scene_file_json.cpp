@@ -387,20 +387,29 @@ bool scan_plain_string(std::string_view t, size_t& i, std::string_view& out) {
     return true;
 }
 
-/// A JSON number at t[i], converted as nlohmann::json converts it (integers as 64-bit integers,
-/// then to double; others with correct rounding). False when out of range (the general path
-/// reports or rounds those).
-bool scan_number(std::string_view t, size_t& i, double& out) {
+/// The characters of the JSON number at t[i] (valid JSON): [first, last), i past them, and
+/// whether it is an integer (no fraction, no exponent). False for none or an overlong one.
+bool number_token(std::string_view t, size_t& i, const char*& first, const char*& last, bool& integer) {
     const size_t begin = i;
-    bool integer = true;
+    integer = true;
     while (i < t.size() && (std::isdigit(static_cast<unsigned char>(t[i])) || t[i] == '-' || t[i] == '+' ||
                             t[i] == '.' || t[i] == 'e' || t[i] == 'E')) {
         integer &= t[i] != '.' && t[i] != 'e' && t[i] != 'E';
         ++i;
     }
     if (i == begin || i - begin > 40) return false;
-    const char* first = t.data() + begin;
-    const char* last = t.data() + i;
+    first = t.data() + begin;
+    last = t.data() + i;
+    return true;
+}
+
+/// A JSON number at t[i], converted as nlohmann::json converts it (integers as 64-bit integers,
+/// then to double; others with correct rounding). False when out of range (the general path
+/// reports or rounds those).
+bool scan_number(std::string_view t, size_t& i, double& out) {
+    const char *first = nullptr, *last = nullptr;
+    bool integer = true;
+    if (!number_token(t, i, first, last, integer)) return false;
     if (integer) {
         long long v = 0;
         const auto r = std::from_chars(first, last, v);
@@ -411,24 +420,13 @@ bool scan_number(std::string_view t, size_t& i, double& out) {
     return r.ec == std::errc() && r.ptr == last;
 }
 
-}  // namespace
-
-namespace {
-
 /// A JSON number at t[i] as nlohmann::json stores it: an integer as int64 (with a sign) or uint64,
 /// anything else as a correctly rounded double. False when out of range (nlohmann then falls back
 /// to a double, or the general path reports it).
 bool scan_json_number(std::string_view t, size_t& i, Json& out) {
-    const size_t begin = i;
+    const char *first = nullptr, *last = nullptr;
     bool integer = true;
-    while (i < t.size() && (std::isdigit(static_cast<unsigned char>(t[i])) || t[i] == '-' || t[i] == '+' ||
-                            t[i] == '.' || t[i] == 'e' || t[i] == 'E')) {
-        integer &= t[i] != '.' && t[i] != 'e' && t[i] != 'E';
-        ++i;
-    }
-    if (i == begin || i - begin > 40) return false;
-    const char* first = t.data() + begin;
-    const char* last = t.data() + i;
+    if (!number_token(t, i, first, last, integer)) return false;
     if (integer && *first == '-') {
         int64_t v = 0;
         const auto r = std::from_chars(first, last, v);
