@@ -255,7 +255,7 @@ Command register_bench_process(CLI::App& bench) {
                     "scene files (spheres, cylinders, cones, discs, meshes, planes, classic materials, point and "
                     "directional lights)")
         ->delimiter(',')
-        ->check(CLI::IsMember({"whitted1980", "rings", "tree", "balls", "tetra", "mount", "gears"}) | CLI::ExistingFile)
+        ->check(CLI::IsMember(povray_scene_names()) | CLI::ExistingFile)
         ->capture_default_str();
     app->add_option("--spd-size", o->povray.spd_size, "--vs-povray: SPD size factor of the SPD-style scenes")
         ->check(CLI::Range(1, 6))

@@ -208,11 +208,13 @@ void add_gear(Mesh& m, const Vec3d& centre, double inner, double outer, double t
     }
 }
 
-void add_mesh(Scene& s, Mesh m, uint32_t material) {
+/// Appends `m` with `material` and the instance placing it (named after it) by `world`.
+void add_mesh(Scene& s, Mesh m, uint32_t material, const Mat4d& world = Mat4d()) {
     m.material = material;
     s.meshes.push_back(std::move(m));
     Instance inst;
     inst.mesh = uint32_t(s.meshes.size() - 1);
+    inst.world_from_object = world;
     inst.node_name = s.meshes.back().name;
     s.instances.push_back(inst);
 }
@@ -316,7 +318,6 @@ Scene tessellate_quadrics(const Scene& in, int segments) {
     for (const Quadric& q : in.quadrics) {
         Mesh m;
         m.name = q.name;
-        m.material = q.material;
         auto vertex = [&](const Vec3d& p, const Vec3d& n) {
             m.positions.push_back(Vec3f(p));
             m.normals.push_back(Vec3f(normalize(n)));
@@ -351,12 +352,7 @@ Scene tessellate_quadrics(const Scene& in, int segments) {
                 if (q.radius1 > 0) fan(q.height, q.radius1, 1.0);
             }
         }
-        s.meshes.push_back(std::move(m));
-        Instance inst;
-        inst.mesh = uint32_t(s.meshes.size() - 1);
-        inst.world_from_object = q.world_from_object;
-        inst.node_name = q.name;
-        s.instances.push_back(inst);
+        add_mesh(s, std::move(m), q.material, q.world_from_object);
     }
     return s;
 }

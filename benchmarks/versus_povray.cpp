@@ -69,6 +69,17 @@ std::vector<Setting> povray_settings() {
     return s;
 }
 
+}  // namespace
+
+std::vector<std::string> povray_scene_names() {
+    std::vector<std::string> names{"whitted1980"};
+    const std::vector<std::string>& spd = spd_scene_names();
+    names.insert(names.end(), spd.begin(), spd.end());
+    return names;
+}
+
+namespace {
+
 /// The label of POV-Ray's usual setting (+A with its default threshold, method and depth).
 constexpr const char* kPovrayUsual = "+AM1 +A0.3 +R3";
 

@@ -17,13 +17,16 @@
 
 namespace whitted::app {
 
+/// The scenes the comparison knows by name: whitted1980, then spd_scene_names().
+std::vector<std::string> povray_scene_names();
+
 struct VersusPovrayOptions {
     std::string whitted;                 ///< the whitted executable
     std::string povray = "povray";       ///< POV-Ray: a path, or a name looked up on the PATH
     /// whitted1980 (the bundled classic scene, 1920x1080), the SPD-style scenes (spd_scenes.h:
     /// rings, tree, balls, tetra, mount, gears; 512x512), or paths of classic scene files (at
     /// their render size, else 1920x1080)
-    std::vector<std::string> scenes{"whitted1980", "rings", "tree", "balls", "tetra", "mount", "gears"};
+    std::vector<std::string> scenes = povray_scene_names();
     int spd_size = 3;                    ///< SPD size factor of the SPD-style scenes
     double scale = 1.0;                  ///< image sizes scaled by this (tests use small images)
     int repeat = 3;

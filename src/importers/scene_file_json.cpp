@@ -474,107 +474,93 @@ bool scan_number_array(std::string_view t, size_t& i, Json& out, bool nested) {
     }
 }
 
+/// The plain object at t[i] (a '{'): `member(key, i)` reads each member's value at t[i], leaving i
+/// past it, and returns the member's bit (0: not one it reads). Returns the bits of the members
+/// read, with i past the '}'; 0 when a member is not read or repeats, or a key has escapes.
+template <class Member>
+unsigned scan_members(std::string_view t, size_t& i, Member&& member) {
+    if (i >= t.size() || t[i] != '{') return 0;
+    unsigned seen = 0;
+    i = skip_ws(t, i + 1);
+    while (true) {
+        std::string_view key;
+        if (!scan_plain_string(t, i, key)) return 0;
+        i = skip_ws(t, i);
+        if (i >= t.size() || t[i] != ':') return 0;
+        i = skip_ws(t, i + 1);
+        const unsigned bit = member(key, i);
+        if (bit == 0 || (seen & bit)) return 0;
+        seen |= bit;
+        i = skip_ws(t, i);
+        if (i < t.size() && t[i] == '}') {
+            ++i;
+            return seen;
+        }
+        if (i >= t.size() || t[i] != ',') return 0;
+        i = skip_ws(t, i + 1);
+    }
+}
+
 }  // namespace
 
 bool scan_mesh(std::string_view t, Json& out) {
     enum : unsigned { kType = 1, kPositions = 2, kIndices = 4, kNormals = 8, kMaterial = 16, kName = 32, kTransform = 64 };
-    unsigned seen = 0;
     out = Json::object();
     size_t i = skip_ws(t, 0);
-    if (i >= t.size() || t[i] != '{') return false;
-    i = skip_ws(t, i + 1);
-    while (true) {
-        std::string_view key, text;
-        if (!scan_plain_string(t, i, key)) return false;
-        i = skip_ws(t, i);
-        if (i >= t.size() || t[i] != ':') return false;
-        i = skip_ws(t, i + 1);
+    const unsigned seen = scan_members(t, i, [&](std::string_view key, size_t& j) -> unsigned {
         unsigned bit = 0;
         Json value;
         if (key == "type" || key == "material" || key == "name") {
-            if (!scan_plain_string(t, i, text) || (key == "type" && text != "mesh")) return false;
+            std::string_view text;
+            if (!scan_plain_string(t, j, text) || (key == "type" && text != "mesh")) return 0;
             value = std::string(text);
             bit = key == "type" ? kType : key == "material" ? kMaterial : kName;
         } else if (key == "positions" || key == "indices" || key == "normals") {
-            if (!scan_number_array(t, i, value, true)) return false;
+            if (!scan_number_array(t, j, value, true)) return 0;
             bit = key == "positions" ? kPositions : key == "indices" ? kIndices : kNormals;
         } else if (key == "transform") {  // exactly {"matrix": [numbers]}
-            std::string_view matrix;
-            if (i >= t.size() || t[i] != '{') return false;
-            i = skip_ws(t, i + 1);
-            if (!scan_plain_string(t, i, matrix) || matrix != "matrix") return false;
-            i = skip_ws(t, i);
-            if (i >= t.size() || t[i] != ':') return false;
-            i = skip_ws(t, i + 1);
             Json numbers;
-            if (!scan_number_array(t, i, numbers, false)) return false;
-            i = skip_ws(t, i);
-            if (i >= t.size() || t[i] != '}') return false;
-            ++i;
+            if (scan_members(t, j, [&](std::string_view k, size_t& m) -> unsigned {
+                    return k == "matrix" && scan_number_array(t, m, numbers, false) ? 1u : 0u;
+                }) == 0)
+                return 0;
             value = Json::object();
             value["matrix"] = std::move(numbers);
             bit = kTransform;
         } else {
-            return false;
+            return 0;
         }
-        if (seen & bit) return false;
-        seen |= bit;
-        out[std::string(key)] = std::move(value);
-        i = skip_ws(t, i);
-        if (i < t.size() && t[i] == '}') break;
-        if (i >= t.size() || t[i] != ',') return false;
-        i = skip_ws(t, i + 1);
-    }
-    return skip_ws(t, i + 1) == t.size() && (seen & (kType | kPositions)) == (kType | kPositions);
+        out[std::string(key)] = std::move(value);  // a repeated key makes scan_members fail: out is not used
+        return bit;
+    });
+    return skip_ws(t, i) == t.size() && (seen & (kType | kPositions)) == (kType | kPositions);
 }
 
 bool scan_sphere(std::string_view t, SphereFields& f) {
-    enum : unsigned { kType = 1, kCenter = 2, kRadius = 4, kMaterial = 8, kName = 16 };
-    unsigned seen = 0;
+    constexpr unsigned kType = 1, kCenter = 2, kRadius = 4, kMaterial = 8, kName = 16;
     size_t i = skip_ws(t, 0);
-    if (i >= t.size() || t[i] != '{') return false;
-    i = skip_ws(t, i + 1);
-    while (true) {
-        std::string_view key;
-        if (!scan_plain_string(t, i, key)) return false;
-        i = skip_ws(t, i);
-        if (i >= t.size() || t[i] != ':') return false;
-        i = skip_ws(t, i + 1);
-        unsigned bit = 0;
+    const unsigned seen = scan_members(t, i, [&](std::string_view key, size_t& j) -> unsigned {
         if (key == "type") {
             std::string_view type;
-            if (!scan_plain_string(t, i, type) || type != "sphere") return false;
-            bit = kType;
-        } else if (key == "center") {
-            if (i >= t.size() || t[i] != '[') return false;
-            for (int k = 0; k < 3; ++k) {
-                i = skip_ws(t, i + 1);
-                if (!scan_number(t, i, f.center[k])) return false;
-                i = skip_ws(t, i);
-                if (i >= t.size() || t[i] != (k < 2 ? ',' : ']')) return false;
-            }
-            ++i;
-            bit = kCenter;
-        } else if (key == "radius") {
-            if (!scan_number(t, i, f.radius)) return false;
-            bit = kRadius;
-        } else if (key == "material") {
-            if (!scan_plain_string(t, i, f.material)) return false;
-            bit = kMaterial;
-        } else if (key == "name") {
-            if (!scan_plain_string(t, i, f.name)) return false;
-            bit = kName;
-        } else {
-            return false;
+            return scan_plain_string(t, j, type) && type == "sphere" ? kType : 0;
         }
-        if (seen & bit) return false;
-        seen |= bit;
-        i = skip_ws(t, i);
-        if (i < t.size() && t[i] == '}') break;
-        if (i >= t.size() || t[i] != ',') return false;
-        i = skip_ws(t, i + 1);
-    }
-    if (skip_ws(t, i + 1) != t.size() || (seen & (kType | kCenter | kRadius)) != (kType | kCenter | kRadius)) return false;
+        if (key == "center") {
+            if (j >= t.size() || t[j] != '[') return 0;
+            for (int k = 0; k < 3; ++k) {
+                j = skip_ws(t, j + 1);
+                if (!scan_number(t, j, f.center[k])) return 0;
+                j = skip_ws(t, j);
+                if (j >= t.size() || t[j] != (k < 2 ? ',' : ']')) return 0;
+            }
+            ++j;
+            return kCenter;
+        }
+        if (key == "radius") return scan_number(t, j, f.radius) ? kRadius : 0;
+        if (key == "material") return scan_plain_string(t, j, f.material) ? kMaterial : 0;
+        if (key == "name") return scan_plain_string(t, j, f.name) ? kName : 0;
+        return 0;
+    });
+    if (skip_ws(t, i) != t.size() || (seen & (kType | kCenter | kRadius)) != (kType | kCenter | kRadius)) return false;
     f.has_material = seen & kMaterial;
     f.has_name = seen & kName;
     return true;
