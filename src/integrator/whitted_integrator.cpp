@@ -38,24 +38,24 @@ PrimaryInfo first_hit(const Hit& hit, const Vec3f& N, const WhittedCoeffs& c) {
     return {true, hit.t, N, c.kd + c.kr + c.kt, hit.prim, hit.inst};
 }
 
-/// Transmittances along the rays ray(k), k < m, of one point as one batch query of `accel`:
-/// put(k, t) for each; put(k, none) where ray(k) gives no ray. Adds the rays traced to `traced`.
+/// Transmittances along the rays of one point as one batch query of `accel`: ray(k, r), k < m,
+/// writes ray k into r and returns true, or returns false where there is none; put(k, t) for each,
+/// put(k, none) where there is no ray. Adds the rays traced to `traced`. The rays are written in
+/// place in the batch (a Ray built elsewhere and copied in stalled on reading back its own
+/// narrower stores).
 template <typename MakeRay, typename Put>
 void batch_transmittance(const Accelerator& accel, size_t m, MakeRay ray, Put put, const Color& none,
                          uint64_t& traced) {
     thread_local std::vector<Ray> rays;
     thread_local std::vector<Color> through;
     thread_local std::vector<uint32_t> slot;
-    rays.clear();
+    rays.resize(m);
     slot.clear();
     for (size_t k = 0; k < m; ++k) {
-        if (const std::optional<Ray> r = ray(k)) {
-            rays.push_back(*r);
-            slot.push_back(uint32_t(k));
-        } else {
-            put(k, none);
-        }
+        if (ray(k, rays[slot.size()])) slot.push_back(uint32_t(k));
+        else put(k, none);
     }
+    rays.resize(slot.size());
     traced += rays.size();
     through.resize(rays.size());
     accel.transmittance(std::span<const Ray>(rays), std::span<Color>(through));
@@ -247,19 +247,18 @@ Color WhittedIntegrator::environment_visibility(const Shading& s, float stake, R
     cells.assign(grid.size(), Cell{});
     const SmoothFrame frame(s.f.N);
     const Vec3f org = m_offset.origin(s.f.front ? s.sp.p_shadow : s.sp.p, s.sp.offset_scale, s.f.Ng);
-    // The occlusion ray toward a direction of the frame, or none below the geometric surface.
-    auto occlusion_ray = [&](const Vec3f& local) -> std::optional<Ray> {
-        Ray r;
+    // The occlusion ray toward a direction of the frame into r; false below the geometric surface.
+    auto occlusion_ray = [&](const Vec3f& local, Ray& r) {
         r.org = org;
         r.dir = frame.to_world(local);
+        r.tnear = 0.f;
         r.tfar = kInfinity;
-        if (!(dot(r.dir, s.f.Ng) > 0.f)) return std::nullopt;
-        return r;
+        return dot(r.dir, s.f.Ng) > 0.f;
     };
     // Transmittances along the directions local(0..m), one batch query (1 below the surface).
     auto transmittance_along = [&](size_t m, auto local, auto put) {
         batch_transmittance(
-            m_accel, m, [&](size_t k) { return occlusion_ray(local(k)); }, put, Color(1.f), counters.occlusion);
+            m_accel, m, [&](size_t k, Ray& r) { return occlusion_ray(local(k), r); }, put, Color(1.f), counters.occlusion);
     };
     Color total(0.f);
     for (size_t k = 0; k < cells.size(); ++k) {
@@ -375,18 +374,18 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         else return e.potential;
     };
     auto shadowed = [&](const Candidate& e) {
-        const std::optional<Ray> ray = shadow_ray(*e.light, *e.ls, origin(e));
-        if (!ray) return Color(0.f);
+        Ray ray;
+        if (!shadow_ray(*e.light, *e.ls, origin(e), ray)) return Color(0.f);
         count(counters, RayKind::Shadow);
-        return lit(e, m_accel.transmittance(*ray));
+        return lit(e, m_accel.transmittance(ray));
     };
     // The tested extracted lights' shadow rays, one batch query (they are known before any is traced).
     auto shadowed_all = [&](std::span<const uint32_t> ids, std::span<Color> out) {
         batch_transmittance(
             m_accel, ids.size(),
-            [&](size_t k) {
+            [&](size_t k, Ray& r) {
                 const Candidate& e = environment[ids[k]];
-                return shadow_ray(*e.light, *e.ls, origin(e));
+                return shadow_ray(*e.light, *e.ls, origin(e), r);
             },
             [&](size_t k, const Color& shadow) { out[k] = lit(environment[ids[k]], shadow); }, Color(0.f),
             counters.shadow);
@@ -451,20 +450,20 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         shadowed_all, s.weight, m_settings.min_weight, counters.shadow_skipped_dim);
 }
 
-std::optional<Ray> WhittedIntegrator::shadow_ray(const Light& light, const LightSample& ls, const Vec3f& org) {
-    Ray shadow;
+bool WhittedIntegrator::shadow_ray(const Light& light, const LightSample& ls, const Vec3f& org, Ray& shadow) {
     shadow.org = org;
+    shadow.tnear = 0.f;
     if (light.type == LightType::Directional) {
         shadow.dir = ls.L;
         shadow.tfar = kInfinity;
     } else {
         const Vec3f to_light = Vec3f(light.position) - org;
         const float d = length(to_light);
-        if (!(d > 0.f)) return std::nullopt;
+        if (!(d > 0.f)) return false;
         shadow.dir = to_light / d;
         shadow.tfar = d * (1.f - 1e-5f);
     }
-    return shadow;
+    return true;
 }
 
 // ---- Recursive rays: kt T and kr R --------------------------------------------------------------

@@ -172,8 +172,8 @@ private:
                     Color& kr, RayCounters& counters) const;
     Color absorbed(const Shading& s, Color radiance) const;
     /// The shadow ray from `org` toward the light (s_i is the accelerator's transmittance along
-    /// it); none when the point is at the light itself.
-    static std::optional<Ray> shadow_ray(const Light& light, const LightSample& ls, const Vec3f& org);
+    /// it), written into `shadow`; false (none) when the point is at the light itself.
+    static bool shadow_ray(const Light& light, const LightSample& ls, const Vec3f& org, Ray& shadow);
     /// True when a secondary ray of path weight w is worth tracing (w >= min_weight); counts the cut.
     bool worth_tracing(float w, RayCounters& counters) const;
     template <KernelFeatures K>
