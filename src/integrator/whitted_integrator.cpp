@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <iterator>
+#include <new>
 #include <utility>
 
 #include "core/error.h"
@@ -129,13 +130,16 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
             return shade<K>(ray, *cover, depth, counters, primary, cone, weight);
     }
     const ShadingFrame frame = shading_frame(sp, ray.dir);
-    WhittedCoeffs varying;
+    // Storage for coefficients evaluated at this hit, left uninitialised (most hits read a
+    // material's constant ones); they are constructed in it, not copied in.
+    UninitializedArray<WhittedCoeffs, 1> varying_storage;
+    WhittedCoeffs& varying = varying_storage.at[0];
     LayerCoeffs layers;
     const LayerCoeffs* layered = nullptr;
     const WhittedCoeffs* coeffs;
     if constexpr (K.layers) {
         if (mf.layered) {
-            varying = m_view.layered_coefficients(sp, layer_frame(sp, frame), layers);
+            ::new (static_cast<void*>(&varying)) WhittedCoeffs(m_view.layered_coefficients(sp, layer_frame(sp, frame), layers));
             layered = &layers;
             coeffs = &varying;
         } else {
@@ -500,12 +504,10 @@ Color WhittedIntegrator::transmitted(const Shading& s, const Color& kt, Color& k
         if (s.layers && s.layers->dispersion > 0.f && !s.c.thin)
             return dispersed<K>(s, t, kt, kt_through, other_eta, w, kr, counters);
     }
-    const std::optional<Vec3f> dir = transmitted_direction(s.ray.dir, s.f.N, s.f.Ng, eta, s.c.thin);
-    if (!dir) {
+    if (!transmitted_direction(s.ray.dir, s.f.N, s.f.Ng, eta, s.c.thin, t.dir)) {
         kr += kt;
         return Color(0.f);
     }
-    t.dir = *dir;
     return kt_through * trace<K>(t, RayKind::Refraction, s.depth + 1, counters, nullptr, s.secondary, w);
 }
 
@@ -719,9 +721,13 @@ SurfacePoint WhittedIntegrator::surface_point(const Ray& ray, const Hit& hit, co
 template <KernelFeatures K>
 const WhittedCoeffs& WhittedIntegrator::coefficients(const MaterialFeatures& mf, const SurfacePoint& sp,
                                                      WhittedCoeffs& varying) const {
-    if constexpr (!K.tables) return varying = m_view.coefficients(sp);
+    // `varying` may be uninitialised storage: the value is constructed in it (returned into place).
+    auto evaluate = [&]() -> const WhittedCoeffs& {
+        return *::new (static_cast<void*>(&varying)) WhittedCoeffs(m_view.coefficients(sp));
+    };
+    if constexpr (!K.tables) return evaluate();
     else if constexpr (!K.attributes) return mf.constant;
-    else return mf.varying ? (varying = m_view.coefficients(sp)) : mf.constant;
+    else return mf.varying ? evaluate() : mf.constant;
 }
 
 /// The medium of a touching dielectric beyond a hit on a non-thin dielectric (contacts.h).

@@ -15,12 +15,20 @@ inline Vec3f reflect(const Vec3f& V, const Vec3f& N) { return N * (2.f * dot(N, 
 /// Refracted direction for unit incident direction I (travelling toward the surface), unit normal
 /// N on the incident side (dot(I, N) < 0) and eta = n_incident / n_transmitted. Returns nothing on
 /// total internal reflection.
-inline std::optional<Vec3f> refract(const Vec3f& I, const Vec3f& N, float eta) {
+/// The form that writes the direction into T and returns false on total internal reflection
+/// (the renderer's: an optional built in registers and copied out stalled on its narrower stores).
+inline bool refract(const Vec3f& I, const Vec3f& N, float eta, Vec3f& T) {
     float cos_i = -dot(N, I);
     float sin2_t = eta * eta * std::max(0.f, 1.f - cos_i * cos_i);
-    if (sin2_t >= 1.f) return std::nullopt;  // total internal reflection
+    if (sin2_t >= 1.f) return false;  // total internal reflection
     float cos_t = std::sqrt(1.f - sin2_t);
-    return normalize(I * eta + N * (eta * cos_i - cos_t));
+    T = normalize(I * eta + N * (eta * cos_i - cos_t));
+    return true;
+}
+inline std::optional<Vec3f> refract(const Vec3f& I, const Vec3f& N, float eta) {
+    Vec3f T;
+    if (!refract(I, N, eta, T)) return std::nullopt;
+    return T;
 }
 
 /// Direction of the mirror ray at a surface seen from unit V (toward the viewer): V reflected about
@@ -37,12 +45,19 @@ inline Vec3f mirror_direction(const Vec3f& V, const Vec3f& N, const Vec3f& Ng) {
 /// surface, else Snell refraction with eta = n_incident / n_transmitted. Nothing on total
 /// internal reflection, or where the refracted ray would not cross the geometric surface (then
 /// the transmitted weight goes to reflection).
+/// Written into T (false: nothing), as refract(I, N, eta, T).
+inline bool transmitted_direction(const Vec3f& I, const Vec3f& N, const Vec3f& Ng, float eta, bool thin, Vec3f& T) {
+    if (thin) {
+        T = I;
+        return true;
+    }
+    return refract(I, N, eta, T) && dot(T, Ng) < 0.f;
+}
 inline std::optional<Vec3f> transmitted_direction(const Vec3f& I, const Vec3f& N, const Vec3f& Ng, float eta,
                                                   bool thin) {
-    if (thin) return I;
-    const std::optional<Vec3f> T = refract(I, N, eta);
-    if (T && dot(*T, Ng) < 0.f) return T;
-    return std::nullopt;
+    Vec3f T;
+    if (!transmitted_direction(I, N, Ng, eta, thin, T)) return std::nullopt;
+    return T;
 }
 
 /// Schlick's approximation of the Fresnel reflectance for normal-incidence reflectance f0.
