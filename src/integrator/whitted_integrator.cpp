@@ -401,10 +401,11 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         const Light& light = m_view.scene().lights[index];
         // Directional lights (every light extracted from an environment) read their sample in
         // place; the others compute it here.
+        // (The computed one is returned into place: assigned from a temporary, its copy read back
+        // the callee's narrower stores and stalled.)
         const LightSample* cached = m_view.directional_sample(index);
-        LightSample computed;
-        if (!cached) computed = sample_light(light, s.sp.p);
-        const LightSample& ls = cached ? *cached : computed;
+        UninitializedArray<LightSample, 1> computed;
+        const LightSample& ls = cached ? *cached : *::new (static_cast<void*>(computed.at)) LightSample(sample_light(light, s.sp.p));
         if (is_black(ls.intensity)) {  // beyond its range window or outside its spot cone
             ++counters.shadow_skipped_unreached;
             return;

@@ -109,7 +109,7 @@ private:
         const WhittedCoeffs& c;
         const Material& mat;
         const MaterialFeatures& mf;              ///< what the scene analysis knows of mat
-        const ShadingFrame f;
+        const ShadingFrame& f;                   ///< shade()'s frame (held, not copied: the copy stalled)
         const std::optional<OtherMedium> other;  ///< a touching dielectric's medium beyond the surface
         const int depth;
         const RayCone secondary;                 ///< footprint the secondary rays start with
