@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <memory>
 
 #include "accel/factory/create_accelerator.h"
@@ -570,6 +571,44 @@ void expect_sane(const Scene& s, const char* what) {
         }
         EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
     }
+}
+
+// ray_is_traceable is branch-free arithmetic; it must say what its definition says for every
+// mix of finite, zero, tiny, huge, infinite and NaN fields.
+TEST(AccelDegenerate, RayIsTraceableFollowsItsDefinition) {
+    const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+    const float specials[] = {0.f, -0.f, 1.f, -2.5f, 1e-40f, -1e-45f, 3e38f, -3e38f, inf, -inf, nan};
+    auto definition = [](const Ray& r) {
+        return std::isfinite(r.org.x) && std::isfinite(r.org.y) && std::isfinite(r.org.z) && std::isfinite(r.dir.x) &&
+               std::isfinite(r.dir.y) && std::isfinite(r.dir.z) &&
+               (r.dir.x != 0.f || r.dir.y != 0.f || r.dir.z != 0.f) && std::isfinite(r.tnear) && !std::isnan(r.tfar) &&
+               r.tnear <= r.tfar;
+    };
+    size_t checked = 0, traceable = 0;
+    auto check = [&](const Ray& r) {
+        const bool expected = definition(r);
+        ASSERT_EQ(ray_is_traceable(r), expected)
+            << "org " << r.org.x << " " << r.org.y << " " << r.org.z << " dir " << r.dir.x << " " << r.dir.y << " "
+            << r.dir.z << " t " << r.tnear << " " << r.tfar;
+        ++checked;
+        traceable += expected;
+    };
+    // Every pair of the eight fields takes every pair of special values, the others plain.
+    for (int a = 0; a < 8; ++a)
+        for (int b = a; b < 8; ++b)
+            for (const float va : specials)
+                for (const float vb : specials) {
+                    float f[8] = {0.5f, -1.f, 2.f, 0.f, 0.f, 1.f, 0.f, inf};
+                    f[a] = va;
+                    f[b] = vb;
+                    check(Ray{{f[0], f[1], f[2]}, {f[3], f[4], f[5]}, f[6], f[7]});
+                }
+    // The direction's three components over all specials (zero and tiny lengths).
+    for (const float x : specials)
+        for (const float y : specials)
+            for (const float z : specials) check(Ray{{0.f, 0.f, 0.f}, {x, y, z}, 0.f, 10.f});
+    EXPECT_GT(traceable, checked / 10);
+    EXPECT_LT(traceable, checked);
 }
 
 TEST(AccelDegenerate, EmptyScene) {

@@ -26,9 +26,13 @@ constexpr T rounding_gamma(int n) {
 
 /// True for rays every backend traces: finite origin and direction, non-zero direction, a
 /// non-empty [tnear, tfar] (tfar may be +inf). Other rays (NaN, zero direction) miss everything.
+/// Branch-free (the packet backends test every lane of every packet): x - x is 0 for finite x and
+/// NaN for an infinity or NaN, and a sum with a NaN is NaN; a NaN tfar fails tnear <= tfar.
 inline bool ray_is_traceable(const Ray& r) {
-    return is_finite(r.org) && is_finite(r.dir) && (r.dir.x != 0.f || r.dir.y != 0.f || r.dir.z != 0.f) &&
-           std::isfinite(r.tnear) && !std::isnan(r.tfar) && r.tnear <= r.tfar;
+    const float finite = (r.org.x - r.org.x) + (r.org.y - r.org.y) + (r.org.z - r.org.z) + (r.dir.x - r.dir.x) +
+                         (r.dir.y - r.dir.y) + (r.dir.z - r.dir.z) + (r.tnear - r.tnear);
+    const float length = std::fabs(r.dir.x) + std::fabs(r.dir.y) + std::fabs(r.dir.z);
+    return (finite == 0.f) & (length > 0.f) & (r.tnear <= r.tfar);
 }
 
 /// A double-precision box in precision T, rounded outwards (never smaller than `b`).
