@@ -164,6 +164,11 @@ SurfacePoint SceneView::surface(const Ray& ray, const Hit& hit, const RayCone& c
         case GeomKind::Plane: return plane_surface<kAttributes>(ray, hit, cone);
         case GeomKind::Mesh: break;
     }
+    return mesh_surface<kAttributes>(ray, hit, cone);
+}
+
+template <bool kAttributes>
+SurfacePoint SceneView::mesh_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const {
     SurfacePoint sp;
     const Mesh& mesh = m_scene.meshes[hit.geom];
     const InstanceXf& xf = m_xf[hit.inst];

@@ -114,12 +114,16 @@ private:
     /// Coverage alpha at a hit (base color alpha x texture x vertex alpha), UV0/UV1 interpolated.
     float alpha_at(const Material& m, const Hit& hit) const;
     Vec3f world_geometric_normal(const Hit& hit) const;
+    // Each kind's point, out of line: surface() returns each one in place (inlined, its own `sp`
+    // was copied into surface()'s result, a copy that read back narrower stores and stalled).
     template <bool kAttributes>
-    SurfacePoint sphere_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const;
+    [[gnu::noinline]] SurfacePoint mesh_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const;
     template <bool kAttributes>
-    SurfacePoint plane_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const;
+    [[gnu::noinline]] SurfacePoint sphere_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const;
     template <bool kAttributes>
-    SurfacePoint quadric_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const;
+    [[gnu::noinline]] SurfacePoint plane_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const;
+    template <bool kAttributes>
+    [[gnu::noinline]] SurfacePoint quadric_surface(const Ray& ray, const Hit& hit, const RayCone& cone) const;
 
     struct InstanceXf {
         float m[12];            ///< world_from_object, row-major 3x4
