@@ -139,7 +139,8 @@ Color WhittedIntegrator::shade(const Ray& ray, const Hit& hit, int depth, RayCou
     const WhittedCoeffs* coeffs;
     if constexpr (K.layers) {
         if (mf.layered) {
-            ::new (static_cast<void*>(&varying)) WhittedCoeffs(m_view.layered_coefficients(sp, layer_frame(sp, frame), layers));
+            ::new (static_cast<void*>(&varying))
+                WhittedCoeffs(m_view.layered_coefficients(sp, layer_frame(sp, frame), layers));
             layered = &layers;
             coeffs = &varying;
         } else {
@@ -262,7 +263,8 @@ Color WhittedIntegrator::environment_visibility(const Shading& s, float stake, R
     // Transmittances along the directions local(0..m), one batch query (1 below the surface).
     auto transmittance_along = [&](size_t m, auto local, auto put) {
         batch_transmittance(
-            m_accel, m, [&](size_t k, Ray& r) { return occlusion_ray(local(k), r); }, put, Color(1.f), counters.occlusion);
+            m_accel, m, [&](size_t k, Ray& r) { return occlusion_ray(local(k), r); }, put, Color(1.f),
+            counters.occlusion);
     };
     Color total(0.f);
     for (size_t k = 0; k < cells.size(); ++k) {
@@ -405,7 +407,8 @@ Color WhittedIntegrator::direct_light(Color sum, const Shading& s, RayCounters& 
         // the callee's narrower stores and stalled.)
         const LightSample* cached = m_view.directional_sample(index);
         UninitializedArray<LightSample, 1> computed;
-        const LightSample& ls = cached ? *cached : *::new (static_cast<void*>(computed.at)) LightSample(sample_light(light, s.sp.p));
+        const LightSample& ls =
+            cached ? *cached : *::new (static_cast<void*>(computed.at)) LightSample(sample_light(light, s.sp.p));
         if (is_black(ls.intensity)) {  // beyond its range window or outside its spot cone
             ++counters.shadow_skipped_unreached;
             return;

@@ -13,10 +13,9 @@ namespace whitted {
 inline Vec3f reflect(const Vec3f& V, const Vec3f& N) { return N * (2.f * dot(N, V)) - V; }
 
 /// Refracted direction for unit incident direction I (travelling toward the surface), unit normal
-/// N on the incident side (dot(I, N) < 0) and eta = n_incident / n_transmitted. Returns nothing on
-/// total internal reflection.
-/// The form that writes the direction into T and returns false on total internal reflection
-/// (the renderer's: an optional built in registers and copied out stalled on its narrower stores).
+/// N on the incident side (dot(I, N) < 0) and eta = n_incident / n_transmitted, written into T;
+/// false on total internal reflection. The renderer's form: an optional returned and copied out
+/// stalled on reading back its narrower stores. The optional form below returns nothing instead.
 inline bool refract(const Vec3f& I, const Vec3f& N, float eta, Vec3f& T) {
     float cos_i = -dot(N, I);
     float sin2_t = eta * eta * std::max(0.f, 1.f - cos_i * cos_i);
@@ -44,8 +43,7 @@ inline Vec3f mirror_direction(const Vec3f& V, const Vec3f& N, const Vec3f& Ng) {
 /// normal N and geometric normal Ng on the incident side: straight on through a thin-walled
 /// surface, else Snell refraction with eta = n_incident / n_transmitted. Nothing on total
 /// internal reflection, or where the refracted ray would not cross the geometric surface (then
-/// the transmitted weight goes to reflection).
-/// Written into T (false: nothing), as refract(I, N, eta, T).
+/// the transmitted weight goes to reflection). Written into T (false: nothing), as refract's form.
 inline bool transmitted_direction(const Vec3f& I, const Vec3f& N, const Vec3f& Ng, float eta, bool thin, Vec3f& T) {
     if (thin) {
         T = I;
