@@ -53,11 +53,15 @@ public:
     }
 
     Hit intersect(const Ray& ray, RayKind kind) const override {
-        if (!ray_is_traceable(ray)) return Hit{};
-        Ray clipped;
-        const Hit best = nearest_plane(ray, kind, clipped);
-        const Hit h = m_inner->intersect(clipped, kind);
-        return h.valid() ? h : best;
+        // One named result, returned in place: the backend writes its hit straight into it (a copy
+        // of that hit, just written by the backend's narrower stores, stalled). An untraceable ray
+        // stays so (clipped = ray), and the backend misses it too.
+        const bool traceable = ray_is_traceable(ray);
+        Ray clipped = ray;
+        const Hit best = traceable ? nearest_plane(ray, kind, clipped) : Hit{};
+        Hit h = m_inner->intersect(clipped, kind);
+        if (!h.valid()) h = best;
+        return h;
     }
 
     /// As intersect() per ray, with the backend's batch query on the clipped rays (in chunks, so
