@@ -648,14 +648,12 @@ private:
         m_scene.spheres.reserve(m_scene.spheres.size() + m_doc.objects.size());
         for (size_t i = 0; i < m_doc.objects.size(); ++i) {
             const auto [begin, end] = m_doc.objects[i];
-            if (scene_file::SphereFields f;
-                scene_file::scan_sphere(std::string_view(m_doc.text).substr(begin, end - begin), f) &&
-                add_scanned_sphere(f, sphere_count))
+            const std::string_view text = std::string_view(m_doc.text).substr(begin, end - begin);
+            if (scene_file::SphereFields f; scene_file::scan_sphere(text, f) && add_scanned_sphere(f, sphere_count))
                 continue;
             const std::string ptr = sub("/objects", i);
             Json o;  // an exporter's plain mesh without nlohmann's lexer (scan_mesh), else the general parse
-            if (!scene_file::scan_mesh(std::string_view(m_doc.text).substr(begin, end - begin), o))
-                o = scene_file::parse_object(m_doc, i);
+            if (!scene_file::scan_mesh(text, o)) o = scene_file::parse_object(m_doc, i);
             if (!o.is_object()) expected(o, ptr, "an object (sphere, cylinder, cone, disc, plane, box or mesh)");
             const std::string type = choice(
                 require(o, "type", ptr, "an object",
